@@ -1,0 +1,49 @@
+//! Explicit (forward) Euler, first order.
+
+use super::system::{check_state, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
+
+/// Forward Euler with steps of at most `dt`.
+#[derive(Debug, Clone)]
+pub struct Euler {
+    dt: f64,
+    k: Vec<f64>,
+    y_new: Vec<f64>,
+}
+
+impl Euler {
+    /// A stepper with maximum step `dt`.
+    pub fn new(dt: f64) -> Self {
+        Euler {
+            dt,
+            k: Vec::new(),
+            y_new: Vec::new(),
+        }
+    }
+}
+
+impl Stepper for Euler {
+    fn step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure> {
+        let n = y.len();
+        self.k.resize(n, 0.0);
+        self.y_new.resize(n, 0.0);
+        let (h, last) = uniform_step(t, t_end, self.dt);
+        sys.rhs(t, y, &mut self.k);
+        stats.rhs_evals += 1;
+        for i in 0..n {
+            self.y_new[i] = y[i] + h * self.k[i];
+        }
+        sys.project(&mut self.y_new);
+        let t_new = if last { t_end } else { t + h };
+        check_state(sys, t_new, &self.y_new)?;
+        y.copy_from_slice(&self.y_new);
+        stats.steps += 1;
+        Ok(t_new)
+    }
+}

@@ -1,0 +1,18 @@
+//! Time integrators behind one interface: a [`Stepper`] advances an [`OdeSystem`] by one step.
+//!
+//! Fixed-step methods ([`Euler`], [`Rk4`]) split a run into equal steps no longer than `dt` so that a
+//! run of any duration lands exactly on its end time. The adaptive [`Dopri5`] controls the error
+//! per component against [`OdeSystem::error_scale`], which the models set to the size of the slow
+//! drift rather than of the absolute positions (see `engine::micro`).
+
+mod dopri5;
+mod euler;
+mod rk4;
+mod spec;
+mod system;
+
+pub use dopri5::Dopri5;
+pub use euler::Euler;
+pub use rk4::Rk4;
+pub use spec::IntegratorSpec;
+pub use system::{OdeSystem, Problem, Stats, StepFailure, Stepper};

@@ -1,0 +1,71 @@
+//! The user's choice of integrator, as saved with a scene.
+
+use super::{Dopri5, Euler, Rk4, Stepper};
+use crate::engine::error::{require_positive, Result};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Which integrator to use and its one parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "lowercase")]
+pub enum IntegratorSpec {
+    /// Forward Euler with maximum step `dt` (s).
+    Euler {
+        /// Maximum step (s).
+        dt: f64,
+    },
+    /// Classic RK4 with maximum step `dt` (s).
+    Rk4 {
+        /// Maximum step (s).
+        dt: f64,
+    },
+    /// Adaptive Dormand-Prince 5(4) with relative tolerance `rtol`.
+    Dopri5 {
+        /// Relative tolerance (of the drift-sized error scale, see the models).
+        rtol: f64,
+    },
+}
+
+impl IntegratorSpec {
+    /// Forward Euler, checked.
+    pub fn euler(dt: f64) -> Result<Self> {
+        require_positive("euler(dt): dt", dt, "s")?;
+        Ok(IntegratorSpec::Euler { dt })
+    }
+
+    /// Classic RK4, checked.
+    pub fn rk4(dt: f64) -> Result<Self> {
+        require_positive("rk4(dt): dt", dt, "s")?;
+        Ok(IntegratorSpec::Rk4 { dt })
+    }
+
+    /// Dormand-Prince 5(4), checked: 1e-14 ≤ rtol < 1.
+    pub fn dopri5(rtol: f64) -> Result<Self> {
+        require_positive("dopri5(rtol): rtol", rtol, "dimensionless")?;
+        if !(1e-14..1.0).contains(&rtol) {
+            return Err(crate::engine::error::invalid!(
+                "dopri5(rtol): rtol must lie in [1e-14, 1) (below 1e-14 the error estimate is round-off), got {rtol:e}"
+            ));
+        }
+        Ok(IntegratorSpec::Dopri5 { rtol })
+    }
+
+    /// A fresh stepper for this spec.
+    pub fn build(&self) -> Box<dyn Stepper> {
+        match *self {
+            IntegratorSpec::Euler { dt } => Box::new(Euler::new(dt)),
+            IntegratorSpec::Rk4 { dt } => Box::new(Rk4::new(dt)),
+            IntegratorSpec::Dopri5 { rtol } => Box::new(Dopri5::new(rtol)),
+        }
+    }
+}
+
+impl fmt::Display for IntegratorSpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            IntegratorSpec::Euler { dt } => write!(f, "euler({dt:e})"),
+            IntegratorSpec::Rk4 { dt } => write!(f, "rk4({dt:e})"),
+            IntegratorSpec::Dopri5 { rtol } => write!(f, "dopri5({rtol:e})"),
+        }
+    }
+}

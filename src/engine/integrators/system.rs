@@ -1,0 +1,93 @@
+//! The contract between models and integrators.
+
+use serde::{Deserialize, Serialize};
+
+/// A first-order system dy/dt = f(t, y) with the hooks the integrators need.
+pub trait OdeSystem {
+    /// Number of state components.
+    fn dim(&self) -> usize;
+    /// Evaluate the right-hand side f(t, y) into `dy`.
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]);
+    /// Absolute size of each component that a relative tolerance refers to: an adaptive step is
+    /// accepted when |error_i| ≲ rtol · scale_i.
+    fn error_scale(&self, y: &[f64], scale: &mut [f64]);
+    /// Check a freshly computed state (NaN, overlap, ...). `Err` rejects the step.
+    fn check(&mut self, _t: f64, _y: &[f64]) -> Result<(), Problem> {
+        Ok(())
+    }
+    /// Map a state back onto its manifold after a step (e.g. renormalise unit vectors).
+    fn project(&self, _y: &mut [f64]) {}
+}
+
+/// What made a state unacceptable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    /// The swimmer concerned, if one can be named.
+    pub swimmer: Option<usize>,
+    /// What is wrong.
+    pub cause: String,
+    /// What to change.
+    pub hint: String,
+}
+
+/// A step that could not be completed; the caller's state is unchanged.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepFailure {
+    /// Time of the rejected state.
+    pub time: f64,
+    /// Why it was rejected.
+    pub problem: Problem,
+}
+
+/// Work counters of a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected step attempts (error too large or bad state).
+    pub rejected: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: u64,
+}
+
+/// One time-stepping method.
+pub trait Stepper {
+    /// Advance `y` from `t` towards `t_end` (never past it) and return the new time. On `Err` the
+    /// state `y` is left as it was.
+    fn step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure>;
+
+    /// Forget anything cached about the previous state (call when the state was changed from outside).
+    fn reset(&mut self) {}
+}
+
+/// Step size of a fixed-step method: the largest h ≤ dt that divides the remaining span evenly, so
+/// a run ends exactly at `t_end`. Returns (h, is_last).
+pub(crate) fn uniform_step(t: f64, t_end: f64, dt: f64) -> (f64, bool) {
+    let span = t_end - t;
+    // The 1e-9 slack keeps span = k·dt from turning into k+1 steps through rounding.
+    let n = (span / dt - 1e-9).ceil().max(1.0);
+    (span / n, n <= 1.0)
+}
+
+/// Finite-value guard shared by all steppers, applied before the model's own check.
+pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<(), StepFailure> {
+    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+        return Err(StepFailure {
+            time: t,
+            problem: Problem {
+                swimmer: None,
+                cause: format!("state component {i} became NaN or infinite"),
+                hint: "use a smaller time step (the spring is stiff: see s.stiff_dt) or the adaptive dopri5".into(),
+            },
+        });
+    }
+    sys.check(t, y)
+        .map_err(|problem| StepFailure { time: t, problem })
+}

@@ -1,0 +1,163 @@
+//! The microscopic model (e:langevin, e:Mazur, e:swimmer_potential): spheres moved by spring forces
+//! through the mobility, dX_α/dt = Σ_β H_αβ F_β.
+//!
+//! In the state variables of [`super::model`] (ΔR_H and b = X₂ − X₁ per dumbbell), with interaction
+//! velocities u_α = Σ_{β≠α} H_αβ F_β and spring force f = k0 (|b| − L) b̂ on sphere 1 (−f on sphere 2):
+//! - dR_H/dt = (a1 u₁ + a2 u₂)/(a1+a2): the Stokes-drag parts a_α F_α/(6πμa_α) cancel exactly
+//!   because the dumbbell is force-free, so they are never added (no cancellation in floating point);
+//! - db/dt = −f (1/γ₁ + 1/γ₂) + u₂ − u₁, γ = 6πμa.
+
+use super::integrators::{OdeSystem, Problem};
+use super::mobility::{self_mobility, Mobility};
+use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
+use super::swimmer::Dumbbell;
+use nalgebra::Vector3;
+
+/// The microscopic right-hand side with its scratch buffers.
+#[derive(Debug, Clone)]
+pub struct MicroSystem {
+    swimmers: Vec<Dumbbell>,
+    base: Vec<Vector3<f64>>,
+    mu: f64,
+    mobility: Mobility,
+    radii: Vec<f64>,
+    pos: Vec<Vector3<f64>>,
+    forces: Vec<Vector3<f64>>,
+    u: Vec<Vector3<f64>>,
+}
+
+impl MicroSystem {
+    /// A system for these swimmers, base positions, viscosity and mobility.
+    pub fn new(swimmers: &[Dumbbell], base: &[Vector3<f64>], mu: f64, mobility: Mobility) -> Self {
+        let n = 2 * swimmers.len();
+        MicroSystem {
+            swimmers: swimmers.to_vec(),
+            base: base.to_vec(),
+            mu,
+            mobility,
+            radii: swimmers.iter().flat_map(|d| [d.a1, d.a2]).collect(),
+            pos: vec![Vector3::zeros(); n],
+            forces: vec![Vector3::zeros(); n],
+            u: vec![Vector3::zeros(); n],
+        }
+    }
+
+    /// Sphere positions of the state `y` (sphere 2σ has radius a1, 2σ+1 radius a2).
+    pub fn sphere_positions(&self, y: &[f64], out: &mut [Vector3<f64>]) {
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let rh = self.base[s] + vec3(y, STATE_PER_SWIMMER * s);
+            let b = vec3(y, STATE_PER_SWIMMER * s + 3);
+            out[2 * s] = rh - d.w2() * b;
+            out[2 * s + 1] = rh + d.w1() * b;
+        }
+    }
+
+    /// Spring tensions k0 (d − L) of every dumbbell at time `t` (N); positive when stretched.
+    pub fn tensions(&self, t: f64, y: &[f64]) -> Vec<f64> {
+        self.swimmers
+            .iter()
+            .enumerate()
+            .map(|(s, d)| d.k0 * (vec3(y, STATE_PER_SWIMMER * s + 3).norm() - d.rest_length(t)))
+            .collect()
+    }
+}
+
+impl OdeSystem for MicroSystem {
+    fn dim(&self) -> usize {
+        STATE_PER_SWIMMER * self.swimmers.len()
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let mut pos = std::mem::take(&mut self.pos);
+        self.sphere_positions(y, &mut pos);
+        self.pos = pos;
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let b = vec3(y, STATE_PER_SWIMMER * s + 3);
+            let len = b.norm();
+            let f = d.k0 * (len - d.rest_length(t)) / len * b;
+            self.forces[2 * s] = f;
+            self.forces[2 * s + 1] = -f;
+        }
+        self.mobility.interaction_velocities(
+            self.mu,
+            &self.pos,
+            &self.radii,
+            &self.forces,
+            &mut self.u,
+        );
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let (u1, u2) = (self.u[2 * s], self.u[2 * s + 1]);
+            let f = self.forces[2 * s];
+            let drh = d.w1() * u1 + d.w2() * u2;
+            let db = -(self_mobility(self.mu, d.a1) + self_mobility(self.mu, d.a2)) * f + u2 - u1;
+            set_vec3(dy, STATE_PER_SWIMMER * s, &drh);
+            set_vec3(dy, STATE_PER_SWIMMER * s + 3, &db);
+        }
+    }
+
+    /// The dumbbell vector is measured against the stroke λ (its oscillation), the centre against
+    /// λ·(λ/ℓ)²·(Λ/ℓ), the order of the net displacement per period of the closest possible pair: the
+    /// drift is second order in λ/ℓ and first in Λ/ℓ, so this is the size of what the run is after.
+    fn error_scale(&self, _y: &[f64], scale: &mut [f64]) {
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let stroke = d.lambda.max(0.01 * d.ell);
+            let drift = stroke * (stroke / d.ell).powi(2) * (d.big_lambda() / d.ell);
+            let i = STATE_PER_SWIMMER * s;
+            scale[i..i + 3].fill(drift);
+            scale[i + 3..i + 6].fill(stroke);
+        }
+    }
+
+    /// Rejects overlapping spheres, and springs stretched or compressed by more than half a body
+    /// length beyond their rest length: a stiff spring follows L(t) within ~λω/rate ≈ 1e-3 λ, so
+    /// such a deviation is a numerical instability (explicit steps above the stability limit grow
+    /// the spring mode geometrically), never physics.
+    fn check(&mut self, t: f64, y: &[f64]) -> Result<(), Problem> {
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let len = vec3(y, STATE_PER_SWIMMER * s + 3).norm();
+            let dev = len - d.rest_length(t);
+            if dev.abs() > 0.5 * d.ell {
+                return Err(Problem {
+                    swimmer: Some(s),
+                    cause: format!(
+                        "the spring of swimmer {s} is {} by {:.3e} ell beyond its rest length (unstable step)",
+                        if dev > 0.0 { "stretched" } else { "compressed" },
+                        dev.abs() / d.ell
+                    ),
+                    hint: format!(
+                        "use a smaller time step: explicit methods need dt below ~2.8/rate = {:.3e} s here (s.stiff_rate), or the default integrator",
+                        2.785 / d.relaxation_rate(self.mu)
+                    ),
+                });
+            }
+        }
+        let mut pos = std::mem::take(&mut self.pos);
+        self.sphere_positions(y, &mut pos);
+        self.pos = pos;
+        let pos = &self.pos;
+        let n = pos.len();
+        for a in 0..n {
+            for b in (a + 1)..n {
+                let gap = (pos[a] - pos[b]).norm() - self.radii[a] - self.radii[b];
+                if gap <= 0.0 {
+                    let (sa, sb) = (a / 2, b / 2);
+                    let cause = if sa == sb {
+                        format!("the two spheres of swimmer {sa} overlap (gap {gap:.3e} m)")
+                    } else {
+                        format!(
+                            "sphere {} of swimmer {sa} overlaps sphere {} of swimmer {sb} (gap {gap:.3e} m)",
+                            a % 2 + 1,
+                            b % 2 + 1
+                        )
+                    };
+                    return Err(Problem {
+                        swimmer: Some(sa),
+                        cause,
+                        hint: "start the swimmers further apart, or use a smaller time step if the overlap came from a step that was too large".into(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}

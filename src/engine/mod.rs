@@ -1,0 +1,21 @@
+//! The physics and numerics of swimlab: no scripting, no terminal.
+//!
+//! A [`Scene`] holds [`Dumbbell`] swimmers, the fluid viscosity, the [`Model`] that moves them
+//! (microscopic spheres and springs, or stroke-averaged R_H and N), the [`Mobility`] tensor and an
+//! [`IntegratorSpec`]. All quantities are SI.
+
+pub mod averaged;
+pub mod error;
+pub mod integrators;
+pub mod micro;
+pub mod mobility;
+pub mod model;
+pub mod scene;
+pub mod swimmer;
+
+pub use error::{EngineError, Result};
+pub use integrators::IntegratorSpec;
+pub use mobility::Mobility;
+pub use model::{Coefficients, Model};
+pub use scene::Scene;
+pub use swimmer::Dumbbell;

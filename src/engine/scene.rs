@@ -1,0 +1,493 @@
+//! A scene: the swimmers, the fluid, the model that moves them, and the integrator. This is the
+//! engine's single entry point for the script layer.
+
+use super::averaged::AveragedSystem;
+use super::error::{invalid, require_finite, require_positive, EngineError, Result};
+use super::integrators::{IntegratorSpec, OdeSystem, Stats, Stepper};
+use super::micro::MicroSystem;
+use super::mobility::Mobility;
+use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
+use super::swimmer::{unit_direction, Dumbbell};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// Water at room temperature (Pa s), the paper's μ.
+pub const DEFAULT_MU: f64 = 1e-3;
+
+/// The microscopic model's default RK4 step times the stiffest spring's relaxation rate. RK4 is
+/// stable up to 2.785; at 0.8 the stroke-induced wobble of an isolated asymmetric dumbbell's R_H
+/// closes to < 1e-12 ℓ per period (measured 7e-13; at 2.0 it is 6e-11, which would be 5e-5 of the
+/// Fig-1 drift). The error falls as dt⁵ (README, "Accuracy").
+pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
+/// The default step never exceeds this fraction of the shortest period, so that soft springs
+/// (small k0) still resolve the stroke.
+pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
+/// Default tolerance of the averaged model's adaptive integrator.
+pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
+
+/// The swimmers, the fluid and the numerics of one simulation.
+///
+/// State per swimmer: see [`super::model`]. Positions are SI (m), times s. The engine works in SI
+/// throughout: f64 carries relative precision independently of scale, and the adaptive error control
+/// measures each component against a physical scale (stroke λ, drift λ³Λ/ℓ³), not against 1.
+#[derive(Serialize, Deserialize)]
+pub struct Scene {
+    mu: f64,
+    model: Model,
+    mobility: Mobility,
+    coefficients: Coefficients,
+    /// `None`: the model's default.
+    integrator: Option<IntegratorSpec>,
+    swimmers: Vec<Dumbbell>,
+    /// Hydrodynamic centre of each swimmer that the displacement in `state` is measured from.
+    base: Vec<Vector3<f64>>,
+    state: Vec<f64>,
+    time: f64,
+    stats: Stats,
+    /// The stepper of the last run, kept so an adaptive one remembers its step size.
+    #[serde(skip)]
+    stepper: Option<(IntegratorSpec, Box<dyn Stepper>)>,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene {
+            mu: DEFAULT_MU,
+            model: Model::default(),
+            mobility: Mobility::default(),
+            coefficients: Coefficients::default(),
+            integrator: None,
+            swimmers: Vec::new(),
+            base: Vec::new(),
+            state: Vec::new(),
+            time: 0.0,
+            stats: Stats::default(),
+            stepper: None,
+        }
+    }
+}
+
+impl Clone for Scene {
+    fn clone(&self) -> Self {
+        Scene {
+            mu: self.mu,
+            model: self.model,
+            mobility: self.mobility,
+            coefficients: self.coefficients,
+            integrator: self.integrator,
+            swimmers: self.swimmers.clone(),
+            base: self.base.clone(),
+            state: self.state.clone(),
+            time: self.time,
+            stats: self.stats,
+            stepper: None,
+        }
+    }
+}
+
+impl std::fmt::Debug for Scene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Scene({} swimmers, model {}, mobility {}, integrator {}, t = {:e} s)",
+            self.count(),
+            self.model.name(),
+            self.mobility.name(),
+            self.integrator(),
+            self.time
+        )
+    }
+}
+
+impl Scene {
+    /// An empty scene with water's viscosity.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    // ----- configuration -------------------------------------------------------------------
+
+    /// Add a swimmer with hydrodynamic centre `center` (m) and orientation `dir` (any non-zero
+    /// length), at length L(t) of the current time. Returns its 0-based index.
+    pub fn add(&mut self, d: Dumbbell, center: Vector3<f64>, dir: Vector3<f64>) -> Result<usize> {
+        d.validate()?;
+        for (k, c) in ["x", "y", "z"].iter().zip(center.iter()) {
+            require_finite(&format!("center.{k}"), *c)?;
+        }
+        let n = unit_direction(dir)?;
+        let len = d.rest_length(self.time);
+        let (x1, x2) = d.sphere_positions(center, n, len);
+        for (s, other) in self.swimmers.iter().enumerate() {
+            let (y1, y2) = self.spheres(s);
+            for (xa, aa) in [(x1, d.a1), (x2, d.a2)] {
+                for (yb, ab) in [(y1, other.a1), (y2, other.a2)] {
+                    let gap = (xa - yb).norm() - aa - ab;
+                    if gap <= 0.0 {
+                        return Err(invalid!(
+                            "the new swimmer would overlap swimmer {s} (sphere gap {gap:.3e} m); place its centre further away"
+                        ));
+                    }
+                }
+            }
+        }
+        self.swimmers.push(d);
+        self.base.push(center);
+        let v = match self.model {
+            Model::Micro => n * len,
+            Model::Averaged => n,
+        };
+        self.state
+            .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
+        Ok(self.swimmers.len() - 1)
+    }
+
+    /// Viscosity μ (Pa s).
+    pub fn mu(&self) -> f64 {
+        self.mu
+    }
+
+    /// Set the viscosity μ (Pa s).
+    pub fn set_mu(&mut self, mu: f64) -> Result<()> {
+        require_positive("mu", mu, "Pa s")?;
+        self.mu = mu;
+        Ok(())
+    }
+
+    /// The model in use.
+    pub fn model(&self) -> Model {
+        self.model
+    }
+
+    /// Switch the model, converting the state: micro → averaged keeps R_H and N of each dumbbell;
+    /// averaged → micro rebuilds each dumbbell at its rest length L(t) of the current time.
+    pub fn set_model(&mut self, model: Model) {
+        if model == self.model {
+            return;
+        }
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let i = STATE_PER_SWIMMER * s + 3;
+            let v = vec3(&self.state, i);
+            let new = match model {
+                Model::Averaged => v.normalize(),
+                Model::Micro => v * d.rest_length(self.time),
+            };
+            set_vec3(&mut self.state, i, &new);
+        }
+        self.model = model;
+    }
+
+    /// The mobility tensor of the microscopic model.
+    pub fn mobility(&self) -> Mobility {
+        self.mobility
+    }
+
+    /// Set the mobility tensor of the microscopic model.
+    pub fn set_mobility(&mut self, m: Mobility) {
+        self.mobility = m;
+    }
+
+    /// Coefficient set of the averaged model.
+    pub fn coefficients(&self) -> Coefficients {
+        self.coefficients
+    }
+
+    /// Set the coefficient set of the averaged model.
+    pub fn set_coefficients(&mut self, c: Coefficients) {
+        self.coefficients = c;
+    }
+
+    /// The integrator in use (the model's default for this scene unless one was set).
+    pub fn integrator(&self) -> IntegratorSpec {
+        self.integrator.unwrap_or_else(|| self.default_integrator())
+    }
+
+    /// The model's default integrator for the swimmers of this scene.
+    ///
+    /// Microscopic: RK4 at dt = 0.8/rate of the stiffest spring (see
+    /// [`DEFAULT_MICRO_STEP_TIMES_RATE`]), but at most 1/200 of the shortest period. Averaged: dopri5,
+    /// whose steps grow to a good fraction of a period (the averaged model is not stiff).
+    pub fn default_integrator(&self) -> IntegratorSpec {
+        match self.model {
+            Model::Micro => {
+                let t_min = self
+                    .swimmers
+                    .iter()
+                    .map(Dumbbell::period)
+                    .fold(f64::INFINITY, f64::min);
+                let rate = self.stiff_rate();
+                let dt = (DEFAULT_MICRO_STEP_TIMES_RATE / rate)
+                    .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min);
+                IntegratorSpec::Rk4 {
+                    dt: if dt.is_finite() { dt } else { 1e-6 },
+                }
+            }
+            Model::Averaged => IntegratorSpec::Dopri5 {
+                rtol: DEFAULT_AVERAGED_RTOL,
+            },
+        }
+    }
+
+    /// Whether the integrator is the model's default.
+    pub fn integrator_is_default(&self) -> bool {
+        self.integrator.is_none()
+    }
+
+    /// Set the integrator; `None` returns to the model's default.
+    pub fn set_integrator(&mut self, spec: Option<IntegratorSpec>) {
+        self.integrator = spec;
+    }
+
+    /// Set the stroke phase φ of swimmer `i` (rad).
+    pub fn set_phase(&mut self, i: usize, phase: f64) -> Result<()> {
+        self.check_index(i)?;
+        require_finite("phase", phase)?;
+        self.swimmers[i].phase = phase;
+        Ok(())
+    }
+
+    // ----- reading ---------------------------------------------------------------------------
+
+    /// Number of swimmers.
+    pub fn count(&self) -> usize {
+        self.swimmers.len()
+    }
+
+    /// Current time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Work counters accumulated over all runs.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// The parameters of swimmer `i`.
+    pub fn swimmer(&self, i: usize) -> Result<&Dumbbell> {
+        self.check_index(i)?;
+        Ok(&self.swimmers[i])
+    }
+
+    /// All swimmers' parameters.
+    pub fn swimmers(&self) -> &[Dumbbell] {
+        &self.swimmers
+    }
+
+    /// The common stroke period 2π/ω; an error if the swimmers' ω differ or there are none.
+    pub fn period(&self) -> Result<f64> {
+        let first = self.swimmers.first().ok_or_else(|| {
+            invalid!("the scene has no swimmers, so no period; add one with s.add(dumbbell(#{{}}))")
+        })?;
+        if let Some((i, d)) = self
+            .swimmers
+            .iter()
+            .enumerate()
+            .find(|(_, d)| d.omega != first.omega)
+        {
+            return Err(invalid!(
+                "the swimmers have different omega (swimmer 0: {} 1/s, swimmer {i}: {} 1/s), so there is no common period; use run(seconds) instead",
+                first.omega,
+                d.omega
+            ));
+        }
+        Ok(first.period())
+    }
+
+    fn check_index(&self, i: usize) -> Result<()> {
+        if i < self.swimmers.len() {
+            Ok(())
+        } else if self.swimmers.is_empty() {
+            Err(invalid!(
+                "swimmer index {i} is out of range: the scene has no swimmers"
+            ))
+        } else {
+            Err(invalid!(
+                "swimmer index {i} is out of range: the scene has {} swimmers (0 to {})",
+                self.swimmers.len(),
+                self.swimmers.len() - 1
+            ))
+        }
+    }
+
+    /// Hydrodynamic centre R_H of swimmer `i` (m).
+    pub fn center(&self, i: usize) -> Result<Vector3<f64>> {
+        self.check_index(i)?;
+        Ok(self.base[i] + vec3(&self.state, STATE_PER_SWIMMER * i))
+    }
+
+    /// Displacement of R_H of swimmer `i` since its base position, without rounding against the
+    /// absolute position (m).
+    pub fn displacement(&self, i: usize) -> Result<Vector3<f64>> {
+        self.check_index(i)?;
+        Ok(vec3(&self.state, STATE_PER_SWIMMER * i))
+    }
+
+    /// Unit orientation N of swimmer `i` (from sphere a1 to sphere a2).
+    pub fn dir(&self, i: usize) -> Result<Vector3<f64>> {
+        self.check_index(i)?;
+        Ok(vec3(&self.state, STATE_PER_SWIMMER * i + 3).normalize())
+    }
+
+    /// Current length |X₂ − X₁| of swimmer `i` (m); in the averaged model its rest length L(t).
+    pub fn length(&self, i: usize) -> Result<f64> {
+        self.check_index(i)?;
+        Ok(match self.model {
+            Model::Micro => vec3(&self.state, STATE_PER_SWIMMER * i + 3).norm(),
+            Model::Averaged => self.swimmers[i].rest_length(self.time),
+        })
+    }
+
+    /// Sphere centres (X₁, X₂) of swimmer `i` (m); in the averaged model at rest length L(t).
+    pub fn spheres(&self, i: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let d = &self.swimmers[i];
+        let rh = self.base[i] + vec3(&self.state, STATE_PER_SWIMMER * i);
+        let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
+        match self.model {
+            Model::Micro => (rh - d.w2() * v, rh + d.w1() * v),
+            Model::Averaged => d.sphere_positions(rh, v, d.rest_length(self.time)),
+        }
+    }
+
+    /// Right-hand side at the current state: (dR_H/dt in m/s, dN/dt in 1/s) of swimmer `i`.
+    pub fn rates(&self, i: usize) -> Result<(Vector3<f64>, Vector3<f64>)> {
+        self.check_index(i)?;
+        let mut sys = self.system()?;
+        let mut dy = vec![0.0; self.state.len()];
+        sys.rhs(self.time, &self.state, &mut dy);
+        let k = STATE_PER_SWIMMER * i;
+        let v = vec3(&dy, k);
+        let w = vec3(&dy, k + 3);
+        let spin = match self.model {
+            Model::Averaged => w,
+            Model::Micro => {
+                let b = vec3(&self.state, k + 3);
+                let n = b.normalize();
+                (w - n * n.dot(&w)) / b.norm()
+            }
+        };
+        Ok((v, spin))
+    }
+
+    /// The state vector (see [`super::model`]) and the base positions: for tests and savers.
+    pub fn raw_state(&self) -> (&[f64], &[Vector3<f64>]) {
+        (&self.state, &self.base)
+    }
+
+    fn system(&self) -> Result<Box<dyn OdeSystem>> {
+        Ok(match self.model {
+            Model::Micro => Box::new(MicroSystem::new(
+                &self.swimmers,
+                &self.base,
+                self.mu,
+                self.mobility,
+            )),
+            Model::Averaged => {
+                self.check_averaged()?;
+                Box::new(AveragedSystem::new(
+                    &self.swimmers,
+                    &self.base,
+                    self.coefficients,
+                    &self.state,
+                ))
+            }
+        })
+    }
+
+    /// The averaged equations describe identical strokes: ω, λ and ℓ must agree.
+    fn check_averaged(&self) -> Result<()> {
+        if let Some(first) = self.swimmers.first() {
+            for (i, d) in self.swimmers.iter().enumerate() {
+                if d.omega != first.omega || d.lambda != first.lambda || d.ell != first.ell {
+                    return Err(invalid!(
+                        "the averaged model needs equal omega, lambda and ell for all swimmers (swimmer {i} differs from swimmer 0); use s.model = \"micro\" for mixed strokes"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    // ----- running ---------------------------------------------------------------------------
+
+    /// Advance the scene by `duration` seconds. Equivalent to:
+    ///
+    /// ```text
+    /// t_end = time + duration
+    /// while time < t_end:
+    ///     if interrupted(): stop with Interrupted (state and time of the last step kept)
+    ///     take one step of the integrator towards t_end (never past it)
+    ///     if the new state has NaN/inf or overlapping spheres:
+    ///         adaptive: retry with a smaller step; fixed-step: stop with StepFailed
+    ///         (swimmer, time, cause), keeping the last good state
+    ///     time = new time
+    /// ```
+    pub fn run(&mut self, duration: f64, interrupted: &dyn Fn() -> bool) -> Result<()> {
+        require_finite("duration", duration)?;
+        if duration < 0.0 {
+            return Err(invalid!(
+                "duration must be >= 0 s, got {duration}; the dynamics cannot run backwards"
+            ));
+        }
+        let t_end = self.time + duration;
+        let mut sys = self.system()?;
+        let spec = self.integrator();
+        let mut stepper = match self.stepper.take() {
+            Some((cached, mut st)) if cached == spec => {
+                st.reset();
+                st
+            }
+            _ => spec.build(),
+        };
+        let mut outcome = Ok(());
+        while self.time < t_end {
+            if interrupted() {
+                outcome = Err(EngineError::Interrupted { time: self.time });
+                break;
+            }
+            match stepper.step(
+                sys.as_mut(),
+                self.time,
+                &mut self.state,
+                t_end,
+                &mut self.stats,
+            ) {
+                Ok(t) => self.time = t,
+                Err(f) => {
+                    outcome = Err(EngineError::StepFailed {
+                        time: f.time,
+                        last_good: self.time,
+                        swimmer: f.problem.swimmer,
+                        cause: f.problem.cause,
+                        hint: f.problem.hint,
+                    });
+                    break;
+                }
+            }
+        }
+        self.stepper = Some((spec, stepper));
+        outcome
+    }
+
+    /// Advance by `n` stroke periods (requires a common ω).
+    pub fn run_periods(&mut self, n: f64, interrupted: &dyn Fn() -> bool) -> Result<()> {
+        require_finite("periods", n)?;
+        if n < 0.0 {
+            return Err(invalid!("the number of periods must be >= 0, got {n}"));
+        }
+        let t = self.period()?;
+        self.run(n * t, interrupted)
+    }
+
+    /// The largest spring relaxation rate k0 (1/γ1 + 1/γ2) in the scene (1/s): the stiffness.
+    pub fn stiff_rate(&self) -> f64 {
+        self.swimmers
+            .iter()
+            .map(|d| d.relaxation_rate(self.mu))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// A run that is never interrupted.
+pub fn never() -> bool {
+    false
+}

@@ -1,0 +1,107 @@
+//! Conversions between Rhai values and engine values, with errors that say what was expected.
+
+use crate::engine::EngineError;
+use nalgebra::Vector3;
+use rhai::{Array, Dynamic, EvalAltResult, Position, FLOAT, INT};
+
+/// Result type of script-visible functions.
+pub type ScriptResult<T> = Result<T, Box<EvalAltResult>>;
+
+/// A runtime error with this message; Rhai fills in the script position of the call.
+pub fn script_error(msg: impl Into<String>) -> Box<EvalAltResult> {
+    EvalAltResult::ErrorRuntime(Dynamic::from(msg.into()), Position::NONE).into()
+}
+
+/// Engine errors become script errors carrying the engine's message.
+pub fn from_engine(e: EngineError) -> Box<EvalAltResult> {
+    script_error(e.to_string())
+}
+
+/// Map an engine result into a script result.
+pub fn lift<T>(r: crate::engine::Result<T>) -> ScriptResult<T> {
+    r.map_err(from_engine)
+}
+
+/// A number (integer or float) as f64.
+pub fn number(what: &str, v: &Dynamic) -> ScriptResult<f64> {
+    if let Some(f) = v.clone().try_cast::<FLOAT>() {
+        Ok(f)
+    } else if let Some(i) = v.clone().try_cast::<INT>() {
+        Ok(i as f64)
+    } else {
+        Err(script_error(format!(
+            "{what} must be a number, got {} ({})",
+            v,
+            v.type_name()
+        )))
+    }
+}
+
+/// An array of three numbers as a vector.
+pub fn vector3(what: &str, v: &Dynamic) -> ScriptResult<Vector3<f64>> {
+    let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
+        script_error(format!(
+            "{what} must be an array of 3 numbers such as [1.0, 0.0, 0.0], got {} ({})",
+            v,
+            v.type_name()
+        ))
+    })?;
+    if arr.len() != 3 {
+        return Err(script_error(format!(
+            "{what} must have exactly 3 components, got {}",
+            arr.len()
+        )));
+    }
+    let mut out = Vector3::zeros();
+    for (k, x) in arr.iter().enumerate() {
+        out[k] = number(&format!("{what}[{k}]"), x)?;
+    }
+    Ok(out)
+}
+
+/// A vector as a Rhai array of floats.
+pub fn array3(v: &Vector3<f64>) -> Array {
+    v.iter().map(|x| Dynamic::from_float(*x)).collect()
+}
+
+/// A script index as usize (negative indices are an error).
+pub fn index(i: INT) -> ScriptResult<usize> {
+    usize::try_from(i)
+        .map_err(|_| script_error(format!("swimmer index {i} is negative; indices start at 0")))
+}
+
+/// The closest of `options` to `word` by edit distance, if reasonably close (for "did you mean").
+pub fn suggest<'a>(word: &str, options: &[&'a str]) -> Option<&'a str> {
+    options
+        .iter()
+        .map(|o| (edit_distance(word, o), *o))
+        .filter(|(d, o)| *d <= (o.len() / 2).max(1))
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, o)| o)
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// "unknown X \"w\"; did you mean \"y\"? Valid: a, b, c".
+pub fn unknown_choice(kind: &str, word: &str, options: &[&str]) -> Box<EvalAltResult> {
+    let hint = suggest(word, options)
+        .map(|s| format!(" did you mean \"{s}\"?"))
+        .unwrap_or_default();
+    script_error(format!(
+        "unknown {kind} \"{word}\";{hint} valid: {}",
+        options.join(", ")
+    ))
+}

@@ -1,0 +1,95 @@
+//! `dumbbell(#{...})`: a swimmer's parameters and pose, before it is added to a scene.
+
+use super::convert::{array3, number, script_error, unknown_choice, vector3, ScriptResult};
+use crate::engine::swimmer::unit_direction;
+use crate::engine::Dumbbell;
+use nalgebra::Vector3;
+use rhai::{Engine, Map};
+
+/// The keys `dumbbell(#{...})` accepts.
+pub const KEYS: [&str; 9] = [
+    "a1", "a2", "ell", "lambda", "omega", "k0", "phase", "center", "dir",
+];
+
+/// A swimmer description: parameters plus where to put it (Rhai type `Dumbbell`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DumbbellSpec {
+    /// Parameters (SI).
+    pub params: Dumbbell,
+    /// Hydrodynamic centre (m).
+    pub center: Vector3<f64>,
+    /// Orientation (normalised on use).
+    pub dir: Vector3<f64>,
+}
+
+impl Default for DumbbellSpec {
+    fn default() -> Self {
+        DumbbellSpec {
+            params: Dumbbell::default(),
+            center: Vector3::zeros(),
+            dir: Vector3::x(),
+        }
+    }
+}
+
+impl DumbbellSpec {
+    /// Build from a map; every key optional, unknown keys rejected, parameters validated.
+    pub fn from_map(map: &Map) -> ScriptResult<Self> {
+        let mut spec = DumbbellSpec::default();
+        for (key, value) in map {
+            let p = &mut spec.params;
+            let what = format!("dumbbell key `{key}`");
+            match key.as_str() {
+                "a1" => p.a1 = number(&what, value)?,
+                "a2" => p.a2 = number(&what, value)?,
+                "ell" => p.ell = number(&what, value)?,
+                "lambda" => p.lambda = number(&what, value)?,
+                "omega" => p.omega = number(&what, value)?,
+                "k0" => p.k0 = number(&what, value)?,
+                "phase" => p.phase = number(&what, value)?,
+                "center" => spec.center = vector3(&what, value)?,
+                "dir" => spec.dir = vector3(&what, value)?,
+                other => return Err(unknown_choice("dumbbell key", other, &KEYS)),
+            }
+        }
+        spec.params
+            .validate()
+            .map_err(super::convert::from_engine)?;
+        unit_direction(spec.dir).map_err(super::convert::from_engine)?;
+        if spec.center.iter().any(|c| !c.is_finite()) {
+            return Err(script_error("center must have finite components"));
+        }
+        Ok(spec)
+    }
+}
+
+impl std::fmt::Display for DumbbellSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let p = &self.params;
+        write!(
+            f,
+            "dumbbell(a1 = {:e} m, a2 = {:e} m, ell = {:e} m, lambda = {:e} m, omega = {} 1/s, k0 = {:e} kg/s^2, phase = {} rad, center = [{:e}, {:e}, {:e}] m, dir = [{}, {}, {}])",
+            p.a1, p.a2, p.ell, p.lambda, p.omega, p.k0, p.phase,
+            self.center.x, self.center.y, self.center.z, self.dir.x, self.dir.y, self.dir.z
+        )
+    }
+}
+
+/// Register the `Dumbbell` type and `dumbbell(...)`.
+pub fn register(engine: &mut Engine) {
+    engine
+        .register_type_with_name::<DumbbellSpec>("Dumbbell")
+        .register_fn("dumbbell", |m: Map| DumbbellSpec::from_map(&m))
+        .register_fn("dumbbell", DumbbellSpec::default)
+        .register_fn("to_string", |d: &mut DumbbellSpec| d.to_string())
+        .register_fn("to_debug", |d: &mut DumbbellSpec| d.to_string())
+        .register_get("a1", |d: &mut DumbbellSpec| d.params.a1)
+        .register_get("a2", |d: &mut DumbbellSpec| d.params.a2)
+        .register_get("ell", |d: &mut DumbbellSpec| d.params.ell)
+        .register_get("lambda", |d: &mut DumbbellSpec| d.params.lambda)
+        .register_get("omega", |d: &mut DumbbellSpec| d.params.omega)
+        .register_get("k0", |d: &mut DumbbellSpec| d.params.k0)
+        .register_get("phase", |d: &mut DumbbellSpec| d.params.phase)
+        .register_get("center", |d: &mut DumbbellSpec| array3(&d.center))
+        .register_get("dir", |d: &mut DumbbellSpec| array3(&d.dir));
+}

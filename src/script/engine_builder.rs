@@ -1,0 +1,37 @@
+//! The one place a Rhai engine is built and scripts are run.
+
+use super::{dumbbell_api, integrator_api, interrupt, render_error, scene_api};
+use rhai::{Engine, Scope};
+use std::f64::consts::PI;
+
+/// A Rhai engine with the whole swimlab vocabulary registered.
+pub fn engine() -> Engine {
+    let mut engine = Engine::new();
+    engine.set_max_expr_depths(256, 256);
+    dumbbell_api::register(&mut engine);
+    integrator_api::register(&mut engine);
+    scene_api::register(&mut engine);
+    engine.register_fn("pi", || PI);
+    // Ctrl-C also stops plain script loops between statements.
+    engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
+    engine
+}
+
+/// Run script text; on error return the rendered message (file, line, column, caret).
+pub fn run_source(name: &str, source: &str, scope: &mut Scope) -> Result<(), String> {
+    interrupt::clear();
+    let engine = engine();
+    let ast = engine
+        .compile_with_scope(scope, source)
+        .map_err(|e| render_error(name, source, &e.into()))?;
+    engine
+        .run_ast_with_scope(scope, &ast)
+        .map_err(|e| render_error(name, source, &e))
+}
+
+/// Run a script file.
+pub fn run_file(path: &std::path::Path, scope: &mut Scope) -> Result<(), String> {
+    let source = std::fs::read_to_string(path)
+        .map_err(|e| format!("error: cannot read {}: {e}\n", path.display()))?;
+    run_source(&path.display().to_string(), &source, scope)
+}

@@ -1,0 +1,247 @@
+//! `scene()` and the `Scene` type: build, configure, run and read a simulation from a script.
+//!
+//! A scene is big and stateful, so scripts hold a cheap handle (`Rc<RefCell<Scene>>`): `let t = s;`
+//! names the same scene, as in Python.
+
+use super::convert::{array3, index, lift, number, script_error, unknown_choice, ScriptResult};
+use super::dumbbell_api::DumbbellSpec;
+use super::interrupt;
+use crate::engine::{Coefficients, IntegratorSpec, Mobility, Model, Scene};
+use rhai::{Array, Dynamic, Engine, ImmutableString, INT};
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// A script's handle on a scene (Rhai type `Scene`).
+#[derive(Debug, Clone, Default)]
+pub struct SceneHandle(pub Rc<RefCell<Scene>>);
+
+impl SceneHandle {
+    /// Wrap a scene.
+    pub fn new(scene: Scene) -> Self {
+        SceneHandle(Rc::new(RefCell::new(scene)))
+    }
+
+    fn with<T>(&self, f: impl FnOnce(&Scene) -> crate::engine::Result<T>) -> ScriptResult<T> {
+        lift(f(&self.0.borrow()))
+    }
+
+    fn with_mut<T>(
+        &self,
+        f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
+    ) -> ScriptResult<T> {
+        lift(f(&mut self.0.borrow_mut()))
+    }
+}
+
+fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {
+    v.clone()
+        .into_immutable_string()
+        .map(|s| s.to_string())
+        .map_err(|t| script_error(format!("{what} must be a string, got {v} ({t})")))
+}
+
+fn swimmer_index(v: &Dynamic) -> ScriptResult<usize> {
+    match v.as_int() {
+        Ok(i) => index(i),
+        Err(t) => Err(script_error(format!(
+            "a swimmer index must be an integer such as 0, got {v} ({t})"
+        ))),
+    }
+}
+
+fn summary(s: &Scene) -> String {
+    let period = s
+        .period()
+        .map(|t| format!(", T = {t:.6e} s"))
+        .unwrap_or_default();
+    format!(
+        "Scene({} swimmers, model = \"{}\", mobility = \"{}\", integrator = {}{}, mu = {:e} Pa s, t = {:.6e} s{period})",
+        s.count(),
+        s.model().name(),
+        s.mobility().name(),
+        s.integrator(),
+        if s.integrator_is_default() { " [default]" } else { "" },
+        s.mu(),
+        s.time()
+    )
+}
+
+/// Register the `Scene` type and its methods and properties.
+pub fn register(engine: &mut Engine) {
+    engine
+        .register_type_with_name::<SceneHandle>("Scene")
+        .register_fn("scene", SceneHandle::default)
+        .register_fn("to_string", |s: &mut SceneHandle| summary(&s.0.borrow()))
+        .register_fn("to_debug", |s: &mut SceneHandle| summary(&s.0.borrow()));
+
+    // Building.
+    engine.register_fn(
+        "add",
+        |s: &mut SceneHandle, d: DumbbellSpec| -> ScriptResult<INT> {
+            s.with_mut(|sc| sc.add(d.params, d.center, d.dir))
+                .map(|i| i as INT)
+        },
+    );
+    engine.register_fn(
+        "add",
+        |_: &mut SceneHandle, d: Dynamic| -> ScriptResult<INT> {
+            Err(script_error(format!(
+                "add expects a Dumbbell such as dumbbell(#{{ phase: 0.0 }}), got {d} ({})",
+                d.type_name()
+            )))
+        },
+    );
+
+    // Properties.
+    engine
+        .register_get("time", |s: &mut SceneHandle| s.0.borrow().time())
+        .register_get("count", |s: &mut SceneHandle| s.0.borrow().count() as INT)
+        .register_get("period", |s: &mut SceneHandle| s.with(|sc| sc.period()))
+        .register_get("stiff_rate", |s: &mut SceneHandle| s.0.borrow().stiff_rate())
+        .register_get("mu", |s: &mut SceneHandle| s.0.borrow().mu())
+        .register_set(
+            "mu",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let mu = number("mu", &v)?;
+                s.with_mut(|sc| sc.set_mu(mu))
+            },
+        )
+        .register_get("model", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().model().name()))
+        .register_set(
+            "model",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let name = string_arg("model", &v)?;
+                let m = Model::parse(&name)
+                    .map_err(|_| unknown_choice("model", &name, &["micro", "averaged"]))?;
+                s.0.borrow_mut().set_model(m);
+                Ok(())
+            },
+        )
+        .register_get("mobility", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().mobility().name()))
+        .register_set(
+            "mobility",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let name = string_arg("mobility", &v)?;
+                let m = Mobility::parse(&name)
+                    .map_err(|_| unknown_choice("mobility", &name, &["rpy", "oseen"]))?;
+                s.0.borrow_mut().set_mobility(m);
+                Ok(())
+            },
+        )
+        .register_get("coefficients", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().coefficients().name()))
+        .register_set(
+            "coefficients",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let name = string_arg("coefficients", &v)?;
+                let c = Coefficients::parse(&name).map_err(|_| {
+                    unknown_choice("coefficient set", &name, &["paper", "leading_order"])
+                })?;
+                s.0.borrow_mut().set_coefficients(c);
+                Ok(())
+            },
+        )
+        .register_get("integrator", |s: &mut SceneHandle| s.0.borrow().integrator())
+        .register_set(
+            "integrator",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                if let Some(spec) = v.clone().try_cast::<IntegratorSpec>() {
+                    s.0.borrow_mut().set_integrator(Some(spec));
+                    return Ok(());
+                }
+                match v.clone().into_immutable_string() {
+                    Ok(name) if name == "default" => {
+                        s.0.borrow_mut().set_integrator(None);
+                        Ok(())
+                    }
+                    Ok(name) => Err(unknown_choice("integrator", &name, &["default"])),
+                    Err(t) => Err(script_error(format!(
+                        "integrator must be euler(dt), rk4(dt), dopri5(rtol) or \"default\", got {v} ({t})"
+                    ))),
+                }
+            },
+        );
+
+    // Reading one swimmer.
+    engine
+        .register_fn(
+            "center",
+            |s: &mut SceneHandle, i: Dynamic| -> ScriptResult<Array> {
+                let i = swimmer_index(&i)?;
+                s.with(|sc| sc.center(i)).map(|v| array3(&v))
+            },
+        )
+        .register_fn(
+            "dir",
+            |s: &mut SceneHandle, i: Dynamic| -> ScriptResult<Array> {
+                let i = swimmer_index(&i)?;
+                s.with(|sc| sc.dir(i)).map(|v| array3(&v))
+            },
+        )
+        .register_fn(
+            "velocity",
+            |s: &mut SceneHandle, i: Dynamic| -> ScriptResult<Array> {
+                let i = swimmer_index(&i)?;
+                s.with(|sc| sc.rates(i)).map(|(v, _)| array3(&v))
+            },
+        )
+        .register_fn(
+            "spin",
+            |s: &mut SceneHandle, i: Dynamic| -> ScriptResult<Array> {
+                let i = swimmer_index(&i)?;
+                s.with(|sc| sc.rates(i)).map(|(_, w)| array3(&w))
+            },
+        )
+        .register_fn(
+            "length",
+            |s: &mut SceneHandle, i: Dynamic| -> ScriptResult<f64> {
+                let i = swimmer_index(&i)?;
+                s.with(|sc| sc.length(i))
+            },
+        )
+        .register_fn(
+            "swimmer",
+            |s: &mut SceneHandle, i: Dynamic| -> ScriptResult<DumbbellSpec> {
+                let i = swimmer_index(&i)?;
+                s.with(|sc| {
+                    Ok(DumbbellSpec {
+                        params: *sc.swimmer(i)?,
+                        center: sc.center(i)?,
+                        dir: sc.dir(i)?,
+                    })
+                })
+            },
+        )
+        .register_fn(
+            "set_phase",
+            |s: &mut SceneHandle, i: Dynamic, phase: Dynamic| -> ScriptResult<()> {
+                let i = swimmer_index(&i)?;
+                let phase = number("phase", &phase)?;
+                s.with_mut(|sc| sc.set_phase(i, phase))
+            },
+        );
+
+    // Running.
+    engine
+        .register_fn(
+            "run",
+            |s: &mut SceneHandle, duration: Dynamic| -> ScriptResult<()> {
+                let d = number("run(duration)", &duration)?;
+                s.with_mut(|sc| sc.run(d, &interrupt::requested))
+            },
+        )
+        .register_fn(
+            "run_periods",
+            |s: &mut SceneHandle, n: Dynamic| -> ScriptResult<()> {
+                let n = number("run_periods(n)", &n)?;
+                s.with_mut(|sc| sc.run_periods(n, &interrupt::requested))
+            },
+        )
+        .register_get("stats", |s: &mut SceneHandle| {
+            let st = s.0.borrow().stats();
+            let mut m = rhai::Map::new();
+            m.insert("steps".into(), (st.steps as INT).into());
+            m.insert("rejected".into(), (st.rejected as INT).into());
+            m.insert("rhs_evals".into(), (st.rhs_evals as INT).into());
+            m
+        });
+}

@@ -1,0 +1,115 @@
+//! The Rotne-Prager-Yamakawa-Mazur mobility (e:Mazur): symmetric and positive definite for
+//! non-overlapping spheres, Stokes drag for one sphere, and the Oseen tensor plus the finite-size
+//! r⁻³ term.
+
+use nalgebra::{DVector, Matrix3, Vector3};
+use std::f64::consts::PI;
+use swimlab::engine::Mobility;
+
+const MU: f64 = 1e-3;
+
+/// A small deterministic generator (xorshift) so the configurations are reproducible.
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// `n` spheres with radii in [0.5, 1.5] µm, no two overlapping, some nearly touching.
+fn random_spheres(rng: &mut Rng, n: usize, box_size: f64) -> (Vec<Vector3<f64>>, Vec<f64>) {
+    let mut pos: Vec<Vector3<f64>> = Vec::new();
+    let mut radii = Vec::new();
+    while pos.len() < n {
+        let a = 0.5e-6 + 1e-6 * rng.uniform();
+        let x = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()) * box_size;
+        if pos.iter().zip(&radii).all(|(p, r)| (p - x).norm() > a + r) {
+            pos.push(x);
+            radii.push(a);
+        }
+    }
+    (pos, radii)
+}
+
+#[test]
+fn symmetric_and_positive_definite_for_random_configurations() {
+    let mut rng = Rng(0x9e3779b97f4a7c15);
+    for trial in 0..40 {
+        let n = 2 + trial % 12;
+        // Dense boxes make near contacts, where positive definiteness is tightest.
+        let (pos, radii) = random_spheres(&mut rng, n, 4e-6 * (n as f64).cbrt());
+        for mob in [Mobility::Rpy, Mobility::Oseen] {
+            let m = mob.matrix(MU, &pos, &radii);
+            let asym = (&m - m.transpose()).amax() / m.amax();
+            assert!(asym < 1e-15, "{mob:?}: asymmetry {asym:e}");
+            if mob == Mobility::Rpy {
+                // RPY is positive definite for non-overlapping spheres (the Oseen tensor is not
+                // guaranteed to be, so only RPY is checked).
+                let eig = m.symmetric_eigenvalues();
+                let min = eig.min() / eig.max();
+                assert!(
+                    min > 0.0,
+                    "trial {trial}: smallest eigenvalue ratio {min:e}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn one_sphere_is_stokes_drag() {
+    let a = 1.3e-6;
+    let m = Mobility::Rpy.matrix(MU, &[Vector3::zeros()], &[a]);
+    let f = DVector::from_vec(vec![1e-12, -2e-12, 3e-12]);
+    let v = &m * &f;
+    let expected = &f / (6.0 * PI * MU * a);
+    assert!((&v - &expected).amax() < 1e-15 * expected.amax());
+}
+
+#[test]
+fn oseen_and_rpy_differ_only_by_the_inverse_cube_term() {
+    let r: Vector3<f64> = Vector3::new(3e-6, -1e-6, 2e-6);
+    let (ai, aj) = (0.7e-6, 1.1e-6);
+    let d: f64 = r.norm();
+    let rr = r * r.transpose() / (d * d);
+    let expected = (ai * ai + aj * aj) / (24.0 * PI * MU * d.powi(3))
+        * (Matrix3::<f64>::identity() - 3.0 * rr);
+    let diff =
+        Mobility::Rpy.pair_tensor(MU, &r, ai, aj) - Mobility::Oseen.pair_tensor(MU, &r, ai, aj);
+    assert!((diff - expected).amax() < 1e-14 * expected.amax());
+    // And the Oseen tensor itself: (I + r̂r̂)/(8πμr).
+    let oseen = (Matrix3::<f64>::identity() + rr) / (8.0 * PI * MU * d);
+    let o = Mobility::Oseen.pair_tensor(MU, &r, ai, aj);
+    assert!((o - oseen).amax() < 1e-14 * oseen.amax());
+}
+
+#[test]
+fn interaction_kernel_equals_matrix_product_without_self_terms() {
+    let mut rng = Rng(42);
+    let (pos, radii) = random_spheres(&mut rng, 9, 8e-6);
+    let forces: Vec<Vector3<f64>> = (0..9)
+        .map(|_| {
+            Vector3::new(
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+            ) * 1e-12
+        })
+        .collect();
+    for mob in [Mobility::Rpy, Mobility::Oseen] {
+        let mut u = vec![Vector3::zeros(); 9];
+        mob.interaction_velocities(MU, &pos, &radii, &forces, &mut u);
+        let m = mob.matrix(MU, &pos, &radii);
+        let f = DVector::from_iterator(27, forces.iter().flat_map(|v| v.iter().copied()));
+        let v = &m * &f;
+        for a in 0..9 {
+            let self_part = forces[a] / (6.0 * PI * MU * radii[a]);
+            let expect = Vector3::new(v[3 * a], v[3 * a + 1], v[3 * a + 2]) - self_part;
+            // Round-off of a 9-term sum against the self term it was separated from.
+            assert!((u[a] - expect).norm() < 1e-12 * self_part.norm().max(expect.norm()));
+        }
+    }
+}

@@ -1,0 +1,77 @@
+//! Every shipped script runs through the real binary, and `scripts/pair.rhai` prints the drift the
+//! engine computes.
+
+mod common;
+use std::process::Command;
+
+fn swimlab(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(args)
+        .env("SWIMLAB_QUICK", "1")
+        .output()
+        .expect("swimlab runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn pair_script_prints_the_fig1_drift() {
+    let (ok, out, err) = swimlab(&["run", "scripts/pair.rhai"]);
+    assert!(ok, "{err}");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("collective drift per period:"))
+        .unwrap_or_else(|| panic!("no drift line in:\n{out}"));
+    let value: f64 = line.split_whitespace().nth(4).unwrap().parse().unwrap();
+    // Independent of the script: the engine with a converged integrator.
+    let mut s = common::mirror_inwards(10.0, true);
+    s.set_integrator(Some(common::reference()));
+    let (expected, _) = common::drift_per_period(&mut s, 10.0);
+    assert!(
+        common::rel(value, expected) < 1e-4,
+        "script {value:e}, engine {expected:e}"
+    );
+}
+
+#[test]
+fn run_without_a_file_runs_the_built_in_experiment() {
+    let (ok, out, err) = swimlab(&["run"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("collective drift per period"));
+}
+
+#[test]
+fn every_shipped_script_runs() {
+    let mut n = 0;
+    let mut stack = vec![std::path::PathBuf::from("scripts")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rhai") {
+                let (ok, _, err) = swimlab(&["run", path.to_str().unwrap()]);
+                assert!(ok, "{}: {err}", path.display());
+                n += 1;
+            }
+        }
+    }
+    assert!(n >= 1);
+}
+
+#[test]
+fn errors_exit_non_zero_with_file_line_and_column() {
+    let dir = std::env::temp_dir().join(format!("swimlab-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("bad.rhai");
+    std::fs::write(&f, "let s = scene();\n\ns.model = \"fast\";\n").unwrap();
+    let (ok, _, err) = swimlab(&["run", f.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("bad.rhai:3:"), "{err}");
+    assert!(err.contains("unknown model"), "{err}");
+    let (ok, _, err) = swimlab(&["run", "no/such/file.rhai"]);
+    assert!(!ok && err.contains("cannot read"), "{err}");
+}
