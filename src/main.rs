@@ -27,15 +27,24 @@ enum Command {
     Run {
         /// The .rhai script to run.
         file: Option<PathBuf>,
+        /// Ask the script for its quick variant (scripts read it as `quick()`).
+        #[arg(long)]
+        quick: bool,
     },
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let mut scope = rhai::Scope::new();
+    if let Some(Command::Run { quick: true, .. }) = cli.command {
+        // Read by `quick()` in scripts; set before any script thread exists.
+        std::env::set_var("SWIMLAB_QUICK", "1");
+    }
     let result = match cli.command {
-        Some(Command::Run { file: Some(path) }) => swimlab::script::run_file(&path, &mut scope),
-        Some(Command::Run { file: None }) => {
+        Some(Command::Run {
+            file: Some(path), ..
+        }) => swimlab::script::run_file(&path, &mut scope),
+        Some(Command::Run { file: None, .. }) => {
             swimlab::script::run_source("scripts/pair.rhai (built in)", DEFAULT_SCRIPT, &mut scope)
         }
         None => {

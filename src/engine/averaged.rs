@@ -18,6 +18,39 @@ use nalgebra::Vector3;
 /// |sin(Δφ)| below this counts as zero: phases given as 0 and π differ by rounding only.
 const SIN_ZERO: f64 = 1e-14;
 
+/// Which shortcuts the averaged model may take. All are exact (they skip terms that are zero or
+/// evaluate the same algebra in 1D); switching them off is for tests that prove it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shortcuts {
+    /// Leave out pairs with sin(φσ − φρ) = 0.
+    pub skip_zero_phase_pairs: bool,
+    /// Leave out the I and K terms of symmetric swimmers (A_R = A_N = 0).
+    pub skip_symmetric_terms: bool,
+    /// Use the 1D reduction (e:stroke_averaged) when every centre and orientation is on one line.
+    pub aligned_1d: bool,
+}
+
+impl Default for Shortcuts {
+    fn default() -> Self {
+        Shortcuts {
+            skip_zero_phase_pairs: true,
+            skip_symmetric_terms: true,
+            aligned_1d: true,
+        }
+    }
+}
+
+impl Shortcuts {
+    /// No shortcut: every pair and term is evaluated in 3D.
+    pub fn none() -> Self {
+        Shortcuts {
+            skip_zero_phase_pairs: false,
+            skip_symmetric_terms: false,
+            aligned_1d: false,
+        }
+    }
+}
+
 /// Per-swimmer constants of the averaged equations.
 #[derive(Debug, Clone, Copy)]
 struct Coef {
@@ -73,17 +106,30 @@ pub struct AveragedSystem {
     scale_r: Vec<f64>,
     scale_n: Vec<f64>,
     torque: Vec<Vector3<f64>>,
+    skip_symmetric: bool,
 }
 
 impl AveragedSystem {
-    /// A system for these swimmers; `y` is the current state (used to detect an aligned scene).
+    /// A system for these swimmers with every shortcut; `y` is the current state (used to detect an
+    /// aligned scene).
     pub fn new(swimmers: &[Dumbbell], base: &[Vector3<f64>], set: Coefficients, y: &[f64]) -> Self {
+        Self::with_shortcuts(swimmers, base, set, y, Shortcuts::default())
+    }
+
+    /// A system taking only the given shortcuts.
+    pub fn with_shortcuts(
+        swimmers: &[Dumbbell],
+        base: &[Vector3<f64>],
+        set: Coefficients,
+        y: &[f64],
+        shortcuts: Shortcuts,
+    ) -> Self {
         let coef: Vec<Coef> = swimmers.iter().map(|d| Coef::new(d, set)).collect();
         let mut pairs = Vec::new();
         for (s, cs) in coef.iter().enumerate() {
             for (r, cr) in coef.iter().enumerate() {
                 let sin = (cs.phase - cr.phase).sin();
-                if s != r && sin.abs() > SIN_ZERO {
+                if s != r && (sin.abs() > SIN_ZERO || !shortcuts.skip_zero_phase_pairs) {
                     pairs.push((s, r, sin));
                 }
             }
@@ -103,15 +149,12 @@ impl AveragedSystem {
             pairs,
             axis: None,
             torque: vec![Vector3::zeros(); swimmers.len()],
+            skip_symmetric: shortcuts.skip_symmetric_terms,
         };
-        sys.axis = sys.common_axis(y);
+        if shortcuts.aligned_1d {
+            sys.axis = sys.common_axis(y);
+        }
         sys
-    }
-
-    /// The same system with the 1D shortcut switched off (for tests that compare the two paths).
-    pub fn without_reduction(mut self) -> Self {
-        self.axis = None;
-        self
     }
 
     /// Whether the 1D reduction is in use.
@@ -205,12 +248,12 @@ impl OdeSystem for AveragedSystem {
                     - 42.0 * q * ss * ss * rr
                     + 63.0 * ss.powi(3) * rr * rr);
             let mut t = dh * l;
-            if c.a_r != 0.0 {
+            if c.a_r != 0.0 || !self.skip_symmetric {
                 let i_br = 1.0 - 3.0 * rr * rr - 3.0 * ss * ss - 6.0 * q * ss * rr
                     + 15.0 * ss * ss * rr * rr;
                 v += ns * (c.a_r * c.v0 * sin * (9.0 / 64.0) * c.big_l * xi3 * i_br);
             }
-            if c.a_n != 0.0 {
+            if c.a_n != 0.0 || !self.skip_symmetric {
                 t += dh * (c.a_n * c.w0 * sin * (9.0 / 32.0) * c.big_l * xi4 * jk);
             }
             let i = STATE_PER_SWIMMER * s;

@@ -1,8 +1,7 @@
 //! The one place a Rhai engine is built and scripts are run.
 
-use super::{dumbbell_api, integrator_api, interrupt, render_error, scene_api};
+use super::{csv_api, dumbbell_api, integrator_api, interrupt, render_error, scene_api, util_api};
 use rhai::{Engine, Scope};
-use std::f64::consts::PI;
 
 /// A Rhai engine with the whole swimlab vocabulary registered.
 pub fn engine() -> Engine {
@@ -11,7 +10,8 @@ pub fn engine() -> Engine {
     dumbbell_api::register(&mut engine);
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);
-    engine.register_fn("pi", || PI);
+    csv_api::register(&mut engine);
+    util_api::register(&mut engine);
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
     engine
