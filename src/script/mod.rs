@@ -5,6 +5,7 @@ mod convert;
 mod csv_api;
 mod dumbbell_api;
 mod engine_builder;
+mod float_cmp;
 mod integrator_api;
 pub mod interrupt;
 mod render;
