@@ -75,3 +75,32 @@ fn errors_exit_non_zero_with_file_line_and_column() {
     let (ok, _, err) = swimlab(&["run", "no/such/file.rhai"]);
     assert!(!ok && err.contains("cannot read"), "{err}");
 }
+
+#[test]
+fn set_exposes_values_and_e_evaluates() {
+    let dir = std::env::temp_dir().join(format!("swimlab-set-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("set.rhai");
+    std::fs::write(&f, "print(`${D * 2} ${name} ${flag} ${n + 1}`);\n").unwrap();
+    let (ok, out, err) = swimlab(&[
+        "run",
+        f.to_str().unwrap(),
+        "--set",
+        "D=2.5",
+        "--set",
+        "name=mirror",
+        "--set",
+        "flag=true",
+        "--set",
+        "n=4",
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(out.trim(), "5.0 mirror true 5");
+    let (ok, _, err) = swimlab(&["run", f.to_str().unwrap(), "--set", "2x=1"]);
+    assert!(!ok && err.contains("not a valid variable name"), "{err}");
+    let (ok, out, _) = swimlab(&["-e", "let s = scene(); s.add(dumbbell()); s.count + 1"]);
+    assert!(ok);
+    assert_eq!(out.trim(), "2");
+    let (ok, _, err) = swimlab(&["-e", "let s = scene(); s.model = \"x\""]);
+    assert!(!ok && err.contains("unknown model"), "{err}");
+}

@@ -10,6 +10,8 @@ pub mod integrators;
 pub mod micro;
 pub mod mobility;
 pub mod model;
+pub mod observable;
+pub mod recorder;
 pub mod scene;
 pub mod swimmer;
 
@@ -17,5 +19,7 @@ pub use error::{EngineError, Result};
 pub use integrators::IntegratorSpec;
 pub use mobility::Mobility;
 pub use model::{Coefficients, Model};
+pub use observable::Observable;
+pub use recorder::{Recorder, Trigger};
 pub use scene::Scene;
 pub use swimmer::Dumbbell;

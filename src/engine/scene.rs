@@ -7,6 +7,7 @@ use super::integrators::{IntegratorSpec, OdeSystem, Stats, Stepper};
 use super::micro::MicroSystem;
 use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
+use super::recorder::Recorder;
 use super::swimmer::{unit_direction, Dumbbell};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -24,6 +25,15 @@ pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
 pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
 /// Default tolerance of the averaged model's adaptive integrator.
 pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
+
+/// Version of the JSON layout written by [`Scene::to_json`].
+pub const SAVE_FORMAT: u32 = 1;
+
+#[derive(Serialize)]
+struct SavedScene<'a> {
+    format: u32,
+    scene: &'a Scene,
+}
 
 /// The swimmers, the fluid and the numerics of one simulation.
 ///
@@ -47,6 +57,9 @@ pub struct Scene {
     /// The stepper of the last run, kept so an adaptive one remembers its step size.
     #[serde(skip)]
     stepper: Option<(IntegratorSpec, Box<dyn Stepper>)>,
+    /// Recorders: operations on the scene, not its state (neither saved nor cloned).
+    #[serde(skip)]
+    recorders: Vec<Recorder>,
 }
 
 impl Default for Scene {
@@ -63,10 +76,12 @@ impl Default for Scene {
             time: 0.0,
             stats: Stats::default(),
             stepper: None,
+            recorders: Vec::new(),
         }
     }
 }
 
+/// A clone is a new simulation from the same state: it has no recorders and a fresh stepper.
 impl Clone for Scene {
     fn clone(&self) -> Self {
         Scene {
@@ -81,6 +96,7 @@ impl Clone for Scene {
             time: self.time,
             stats: self.stats,
             stepper: None,
+            recorders: Vec::new(),
         }
     }
 }
@@ -243,6 +259,68 @@ impl Scene {
         require_finite("phase", phase)?;
         self.swimmers[i].phase = phase;
         Ok(())
+    }
+
+    /// All stroke phases φ (rad), in swimmer order.
+    pub fn phases(&self) -> Vec<f64> {
+        self.swimmers.iter().map(|d| d.phase).collect()
+    }
+
+    /// Set all stroke phases at once; the length must match the number of swimmers.
+    pub fn set_phases(&mut self, phases: &[f64]) -> Result<()> {
+        if phases.len() != self.swimmers.len() {
+            return Err(invalid!(
+                "phases: got {} values for {} swimmers; give one phase per swimmer",
+                phases.len(),
+                self.swimmers.len()
+            ));
+        }
+        for (i, p) in phases.iter().enumerate() {
+            require_finite(&format!("phases[{i}]"), *p)?;
+        }
+        for (d, p) in self.swimmers.iter_mut().zip(phases) {
+            d.phase = *p;
+        }
+        Ok(())
+    }
+
+    /// The scene as JSON (swimmers, phases, model, integrator, time, state), exactly round-tripping.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(&SavedScene {
+            format: SAVE_FORMAT,
+            scene: self,
+        })
+        .map_err(|e| invalid!("cannot serialise the scene: {e}"))
+    }
+
+    /// A scene from [`Scene::to_json`] output.
+    pub fn from_json(text: &str) -> Result<Scene> {
+        #[derive(Deserialize)]
+        struct Loaded {
+            format: u32,
+            scene: Scene,
+        }
+        let loaded: Loaded =
+            serde_json::from_str(text).map_err(|e| invalid!("not a swimlab scene file: {e}"))?;
+        if loaded.format != SAVE_FORMAT {
+            return Err(invalid!(
+                "scene file format {} is not supported (this swimlab reads format {SAVE_FORMAT})",
+                loaded.format
+            ));
+        }
+        let s = loaded.scene;
+        let n = s.swimmers.len();
+        if s.base.len() != n || s.state.len() != STATE_PER_SWIMMER * n {
+            return Err(invalid!(
+                "scene file is inconsistent: {n} swimmers but {} base positions and {} state values",
+                s.base.len(),
+                s.state.len()
+            ));
+        }
+        for d in &s.swimmers {
+            d.validate()?;
+        }
+        Ok(s)
     }
 
     // ----- reading ---------------------------------------------------------------------------
@@ -416,11 +494,14 @@ impl Scene {
     /// while time < t_end:
     ///     if interrupted(): stop with Interrupted (state and time of the last step kept)
     ///     take one step of the integrator towards t_end (never past it)
-    ///     if the new state has NaN/inf or overlapping spheres:
+    ///     if the new state has NaN/inf, overlapping spheres or a runaway spring:
     ///         adaptive: retry with a smaller step; fixed-step: stop with StepFailed
     ///         (swimmer, time, cause), keeping the last good state
     ///     time = new time
+    ///     for each recorder due at this time (steps end exactly on due times): take a row
     /// ```
+    /// Recorders also take a row at the end of the run if their trigger is "at end". Rows taken
+    /// before an error or interrupt are kept.
     pub fn run(&mut self, duration: f64, interrupted: &dyn Fn() -> bool) -> Result<()> {
         require_finite("duration", duration)?;
         if duration < 0.0 {
@@ -429,6 +510,37 @@ impl Scene {
             ));
         }
         let t_end = self.time + duration;
+        loop {
+            // Stop where a recorder wants a row, so nothing is evaluated between rows.
+            let segment_end = self
+                .recorders
+                .iter()
+                .filter_map(|r| r.next_due(self.time))
+                .fold(t_end, f64::min)
+                .max(self.time);
+            self.advance_to(segment_end, interrupted)?;
+            let end_of_run = self.time >= t_end;
+            self.fire_recorders(end_of_run)?;
+            if end_of_run {
+                return Ok(());
+            }
+        }
+    }
+
+    fn fire_recorders(&mut self, end_of_run: bool) -> Result<()> {
+        let mut recorders = std::mem::take(&mut self.recorders);
+        let result = recorders
+            .iter_mut()
+            .try_for_each(|r| r.fire(self, end_of_run));
+        self.recorders = recorders;
+        result
+    }
+
+    /// Integrate to `t_end` with the guards (the loop of [`Scene::run`] without recorders).
+    fn advance_to(&mut self, t_end: f64, interrupted: &dyn Fn() -> bool) -> Result<()> {
+        if self.time >= t_end {
+            return Ok(());
+        }
         let mut sys = self.system()?;
         let spec = self.integrator();
         let mut stepper = match self.stepper.take() {
@@ -466,6 +578,19 @@ impl Scene {
         }
         self.stepper = Some((spec, stepper));
         outcome
+    }
+
+    /// Attach a recorder; returns its id.
+    pub fn add_recorder(&mut self, r: Recorder) -> usize {
+        self.recorders.push(r);
+        self.recorders.len() - 1
+    }
+
+    /// A recorder by id.
+    pub fn recorder(&self, id: usize) -> Result<&Recorder> {
+        self.recorders
+            .get(id)
+            .ok_or_else(|| invalid!("recorder {id} does not belong to this scene"))
     }
 
     /// Advance by `n` stroke periods (requires a common ω).

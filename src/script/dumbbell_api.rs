@@ -81,6 +81,14 @@ pub fn register(engine: &mut Engine) {
         .register_type_with_name::<DumbbellSpec>("Dumbbell")
         .register_fn("dumbbell", |m: Map| DumbbellSpec::from_map(&m))
         .register_fn("dumbbell", DumbbellSpec::default)
+        .register_fn("phase", |x: rhai::Dynamic| -> ScriptResult<f64> {
+            Ok(super::convert::number("phase(x)", &x)?.rem_euclid(std::f64::consts::TAU))
+        })
+        .register_fn("phase_deg", |x: rhai::Dynamic| -> ScriptResult<f64> {
+            Ok(super::convert::number("phase_deg(x)", &x)?
+                .to_radians()
+                .rem_euclid(std::f64::consts::TAU))
+        })
         .register_fn("to_string", |d: &mut DumbbellSpec| d.to_string())
         .register_fn("to_debug", |d: &mut DumbbellSpec| d.to_string())
         .register_get("a1", |d: &mut DumbbellSpec| d.params.a1)

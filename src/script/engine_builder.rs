@@ -1,7 +1,8 @@
 //! The one place a Rhai engine is built and scripts are run.
 
 use super::{
-    csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, render_error, scene_api, util_api,
+    csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, observable_api, render_error,
+    scene_api, util_api,
 };
 use rhai::{Engine, Scope};
 
@@ -12,6 +13,7 @@ pub fn engine() -> Engine {
     dumbbell_api::register(&mut engine);
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);
+    observable_api::register(&mut engine);
     float_cmp::register(&mut engine);
     csv_api::register(&mut engine);
     util_api::register(&mut engine);

@@ -3,18 +3,29 @@
 
 mod convert;
 mod csv_api;
+pub mod docs;
 mod dumbbell_api;
 mod engine_builder;
 mod float_cmp;
 mod integrator_api;
 pub mod interrupt;
+mod observable_api;
 mod render;
 mod scene_api;
+mod show;
 mod util_api;
 
 pub use convert::{script_error, ScriptResult};
+
+/// The documented name closest to `word`, for "did you mean".
+pub fn suggest_name(word: &str) -> Option<&'static str> {
+    let names: Vec<&'static str> = docs::DOCS.iter().map(|d| d.name).collect();
+    convert::suggest(word, &names)
+}
 pub use dumbbell_api::DumbbellSpec;
 pub use engine_builder::{engine, run_file, run_source};
+pub use observable_api::RecorderHandle;
 pub use render::render_error;
 pub use scene_api::SceneHandle;
+pub use show::show;
 pub use util_api::quick;

@@ -49,7 +49,8 @@ fn swimmer_index(v: &Dynamic) -> ScriptResult<usize> {
     }
 }
 
-fn summary(s: &Scene) -> String {
+/// One-line description of a scene (what `print(s)` shows).
+pub fn summary(s: &Scene) -> String {
     let period = s
         .period()
         .map(|t| format!(", T = {t:.6e} s"))
@@ -219,6 +220,62 @@ pub fn register(engine: &mut Engine) {
                 s.with_mut(|sc| sc.set_phase(i, phase))
             },
         );
+
+    // Phases, copies, files.
+    engine
+        .register_get("phases", |s: &mut SceneHandle| -> Array {
+            s.0.borrow()
+                .phases()
+                .into_iter()
+                .map(Dynamic::from_float)
+                .collect()
+        })
+        .register_set(
+            "phases",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
+                    script_error(format!(
+                        "phases must be an array of numbers, got {v} ({})",
+                        v.type_name()
+                    ))
+                })?;
+                let ph = arr
+                    .iter()
+                    .enumerate()
+                    .map(|(k, x)| number(&format!("phases[{k}]"), x))
+                    .collect::<ScriptResult<Vec<f64>>>()?;
+                s.with_mut(|sc| sc.set_phases(&ph))
+            },
+        )
+        .register_fn(
+            "phase",
+            |s: &mut SceneHandle, i: Dynamic| -> ScriptResult<f64> {
+                let i = swimmer_index(&i)?;
+                s.with(|sc| sc.swimmer(i).map(|d| d.phase))
+            },
+        )
+        .register_fn("copy", |s: &mut SceneHandle| {
+            SceneHandle::new(s.0.borrow().clone())
+        })
+        .register_fn(
+            "save",
+            |s: &mut SceneHandle, path: &str| -> ScriptResult<()> {
+                let json = s.with(|sc| sc.to_json())?;
+                let p = std::path::Path::new(path);
+                if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    std::fs::create_dir_all(dir).map_err(|e| {
+                        script_error(format!("cannot create folder {}: {e}", dir.display()))
+                    })?;
+                }
+                std::fs::write(p, json)
+                    .map_err(|e| script_error(format!("cannot write {path}: {e}")))
+            },
+        )
+        .register_fn("load_scene", |path: &str| -> ScriptResult<SceneHandle> {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| script_error(format!("cannot read {path}: {e}")))?;
+            lift(Scene::from_json(&text)).map(SceneHandle::new)
+        });
 
     // Running.
     engine

@@ -1,0 +1,190 @@
+//! Named quantities that can be measured on a scene now ([`Observable::evaluate`]) or recorded on a
+//! trigger ([`super::recorder`]). Each knows its name, its components and their unit.
+
+use super::error::{invalid, Result};
+use super::model::Model;
+use super::scene::Scene;
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// A quantity of one swimmer, a pair, or the whole scene.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Observable {
+    /// Hydrodynamic centre R_H of swimmer i (m).
+    CenterH(usize),
+    /// Geometric centre R_G = (X1 + X2)/2 of swimmer i (m).
+    CenterG(usize),
+    /// Unit orientation N of swimmer i.
+    Dir(usize),
+    /// Length |X2 − X1| of swimmer i (m).
+    Length(usize),
+    /// Spring tension k0 (d − L) of swimmer i (N), microscopic model.
+    Tension(usize),
+    /// Mean position (R_H^i + R_H^j)/2 projected on `axis` (m).
+    PairMean(usize, usize, Vector3<f64>),
+    /// Separation R_H^j − R_H^i projected on `axis` (m).
+    PairSeparation(usize, usize, Vector3<f64>),
+    /// q = N^i · N^j.
+    Q(usize, usize),
+    /// D_H = |R_H^i − R_H^j| (m).
+    DistanceH(usize, usize),
+    /// Δq(T) = q(0) − q(T) over the next period (a probe run on a copy of the scene).
+    DeltaQ(usize, usize),
+    /// ΔD_H(T) = [D_H(0) − D_H(T)]/ℓ over the next period (probe run on a copy), in ℓ of swimmer i.
+    DeltaDistanceH(usize, usize),
+    /// Polarization |⟨N⟩|.
+    Polarization,
+    /// Nematic order: largest eigenvalue of Q = ⟨3NN − I⟩/2.
+    Nematic,
+}
+
+impl Observable {
+    /// Short name, e.g. `R_H[0]`, `q[0,1]`.
+    pub fn name(&self) -> String {
+        match self {
+            Observable::CenterH(i) => format!("R_H[{i}]"),
+            Observable::CenterG(i) => format!("R_G[{i}]"),
+            Observable::Dir(i) => format!("N[{i}]"),
+            Observable::Length(i) => format!("length[{i}]"),
+            Observable::Tension(i) => format!("tension[{i}]"),
+            Observable::PairMean(i, j, _) => format!("mean[{i},{j}]"),
+            Observable::PairSeparation(i, j, _) => format!("separation[{i},{j}]"),
+            Observable::Q(i, j) => format!("q[{i},{j}]"),
+            Observable::DistanceH(i, j) => format!("D_H[{i},{j}]"),
+            Observable::DeltaQ(i, j) => format!("dq_T[{i},{j}]"),
+            Observable::DeltaDistanceH(i, j) => format!("dD_H_T[{i},{j}]"),
+            Observable::Polarization => "polarization".into(),
+            Observable::Nematic => "nematic".into(),
+        }
+    }
+
+    /// Unit of every component.
+    pub fn unit(&self) -> &'static str {
+        match self {
+            Observable::CenterH(_)
+            | Observable::CenterG(_)
+            | Observable::Length(_)
+            | Observable::PairMean(..)
+            | Observable::PairSeparation(..)
+            | Observable::DistanceH(..) => "m",
+            Observable::Tension(_) => "N",
+            Observable::DeltaDistanceH(..) => "ell",
+            _ => "1",
+        }
+    }
+
+    /// Column names of the components (`R_H[0].x`, … for vectors; the name for scalars).
+    pub fn columns(&self) -> Vec<String> {
+        let n = self.name();
+        if self.is_vector() {
+            ["x", "y", "z"].iter().map(|c| format!("{n}.{c}")).collect()
+        } else {
+            vec![n]
+        }
+    }
+
+    /// Whether the value has three components.
+    pub fn is_vector(&self) -> bool {
+        matches!(
+            self,
+            Observable::CenterH(_) | Observable::CenterG(_) | Observable::Dir(_)
+        )
+    }
+
+    /// The swimmer indices this observable refers to.
+    fn indices(&self) -> Vec<usize> {
+        match *self {
+            Observable::CenterH(i)
+            | Observable::CenterG(i)
+            | Observable::Dir(i)
+            | Observable::Length(i)
+            | Observable::Tension(i) => vec![i],
+            Observable::PairMean(i, j, _)
+            | Observable::PairSeparation(i, j, _)
+            | Observable::Q(i, j)
+            | Observable::DistanceH(i, j)
+            | Observable::DeltaQ(i, j)
+            | Observable::DeltaDistanceH(i, j) => vec![i, j],
+            Observable::Polarization | Observable::Nematic => vec![],
+        }
+    }
+
+    /// Check that the indices exist in `scene`.
+    pub fn check(&self, scene: &Scene) -> Result<()> {
+        for i in self.indices() {
+            scene.swimmer(i)?;
+        }
+        Ok(())
+    }
+
+    /// The value now (1 or 3 components).
+    pub fn evaluate(&self, s: &Scene) -> Result<Vec<f64>> {
+        self.check(s)?;
+        let v3 = |v: Vector3<f64>| vec![v.x, v.y, v.z];
+        Ok(match *self {
+            Observable::CenterH(i) => v3(s.center(i)?),
+            Observable::CenterG(i) => {
+                let (a, b) = s.spheres(i);
+                v3((a + b) / 2.0)
+            }
+            Observable::Dir(i) => v3(s.dir(i)?),
+            Observable::Length(i) => vec![s.length(i)?],
+            Observable::Tension(i) => {
+                if s.model() != Model::Micro {
+                    return Err(invalid!(
+                        "tension({i}) exists only in the microscopic model (the averaged model has no springs); set s.model = \"micro\""
+                    ));
+                }
+                let d = s.swimmer(i)?;
+                vec![d.k0 * (s.length(i)? - d.rest_length(s.time()))]
+            }
+            Observable::PairMean(i, j, axis) => {
+                // Displacements first: the mean of two large positions would round the drift.
+                let base =
+                    (s.center(i)? - s.displacement(i)? + s.center(j)? - s.displacement(j)?) / 2.0;
+                let disp = (s.displacement(i)? + s.displacement(j)?) / 2.0;
+                vec![base.dot(&axis) + disp.dot(&axis)]
+            }
+            Observable::PairSeparation(i, j, axis) => {
+                vec![(s.center(j)? - s.center(i)?).dot(&axis)]
+            }
+            Observable::Q(i, j) => vec![s.dir(i)?.dot(&s.dir(j)?)],
+            Observable::DistanceH(i, j) => vec![(s.center(i)? - s.center(j)?).norm()],
+            Observable::DeltaQ(i, j) => {
+                let q = Observable::Q(i, j);
+                let (before, after) = Self::over_a_period(s, &q)?;
+                vec![before[0] - after[0]]
+            }
+            Observable::DeltaDistanceH(i, j) => {
+                let d = Observable::DistanceH(i, j);
+                let (before, after) = Self::over_a_period(s, &d)?;
+                vec![(before[0] - after[0]) / s.swimmer(i)?.ell]
+            }
+            Observable::Polarization => {
+                let n = s.count().max(1) as f64;
+                let sum: Vector3<f64> = (0..s.count()).map(|i| s.dir(i).unwrap()).sum();
+                vec![sum.norm() / n]
+            }
+            Observable::Nematic => {
+                if s.count() == 0 {
+                    return Ok(vec![0.0]);
+                }
+                let mut q = Matrix3::zeros();
+                for i in 0..s.count() {
+                    let n = s.dir(i)?;
+                    q += 1.5 * n * n.transpose() - 0.5 * Matrix3::identity();
+                }
+                q /= s.count() as f64;
+                vec![SymmetricEigen::new(q).eigenvalues.max()]
+            }
+        })
+    }
+
+    /// Value of `obs` now and one period later, on a copy of the scene (the scene is not changed).
+    fn over_a_period(s: &Scene, obs: &Observable) -> Result<(Vec<f64>, Vec<f64>)> {
+        let before = obs.evaluate(s)?;
+        let mut probe = s.clone();
+        probe.run_periods(1.0, &super::scene::never)?;
+        Ok((before, obs.evaluate(&probe)?))
+    }
+}

@@ -1,0 +1,135 @@
+//! The front ends: an interactive terminal (rustyline) and piped standard input.
+
+use super::helper::ReplHelper;
+use super::session::{Reply, Session};
+use crate::script::interrupt;
+use rustyline::error::ReadlineError;
+use rustyline::history::DefaultHistory;
+use rustyline::{Config, Editor};
+use std::cell::RefCell;
+use std::io::{BufRead, IsTerminal, Write};
+use std::path::PathBuf;
+use std::rc::Rc;
+
+/// The prompt (also what pty tests wait for).
+pub const PROMPT: &str = "swimlab> ";
+
+/// Where history is kept: $SWIMLAB_HISTORY, else $XDG_DATA_HOME/swimlab/history, else
+/// ~/.local/share/swimlab/history.
+pub fn history_path() -> Option<PathBuf> {
+    if let Some(p) = std::env::var_os("SWIMLAB_HISTORY") {
+        return Some(PathBuf::from(p));
+    }
+    let data = std::env::var_os("XDG_DATA_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")))?;
+    Some(data.join("swimlab").join("history"))
+}
+
+/// Run the REPL on the terminal, or on piped input when stdin is not a terminal. Returns whether
+/// every input succeeded (piped mode's exit status).
+pub fn run() -> bool {
+    // Ctrl-C while a simulation runs: stop it at the next step boundary, keep the scene.
+    let _ = ctrlc::set_handler(interrupt::request);
+    if std::io::stdin().is_terminal() {
+        interactive()
+    } else {
+        piped(std::io::stdin().lock(), &mut std::io::stdout())
+    }
+}
+
+fn interactive() -> bool {
+    let session = Rc::new(RefCell::new(Session::new()));
+    let config = Config::builder().auto_add_history(false).build();
+    let mut rl: Editor<ReplHelper, DefaultHistory> = match Editor::with_config(config) {
+        Ok(rl) => rl,
+        Err(e) => {
+            eprintln!("error: cannot start the line editor: {e}");
+            return false;
+        }
+    };
+    rl.set_helper(Some(ReplHelper::new(session.clone())));
+    let history = history_path();
+    if let Some(h) = &history {
+        let _ = rl.load_history(h);
+    }
+    println!(
+        "swimlab {} — dumbbell swimmers at low Reynolds number. :help lists everything, Ctrl-D leaves.",
+        env!("CARGO_PKG_VERSION")
+    );
+    loop {
+        match rl.readline(PROMPT) {
+            Ok(line) => {
+                if !line.trim().is_empty() {
+                    let _ = rl.add_history_entry(line.as_str());
+                }
+                let reply = session.borrow_mut().handle(&line);
+                match reply {
+                    Reply::Quit => break,
+                    Reply::Output(s) if s.is_empty() => {}
+                    Reply::Output(s) => println!("{s}"),
+                    Reply::Error(s) => print!("{s}{}", if s.ends_with('\n') { "" } else { "\n" }),
+                }
+                let _ = std::io::stdout().flush();
+            }
+            Err(ReadlineError::Interrupted) => println!("(Ctrl-D or :quit leaves)"),
+            Err(ReadlineError::Eof) => break,
+            Err(e) => {
+                eprintln!("error: {e}");
+                break;
+            }
+        }
+    }
+    if let Some(h) = &history {
+        if let Some(dir) = h.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        let _ = rl.save_history(h);
+    }
+    true
+}
+
+/// Read inputs from `input` (multi-line statements joined until they parse), write replies to
+/// `out`. Returns false if any input failed.
+pub fn piped(input: impl BufRead, out: &mut dyn Write) -> bool {
+    let mut session = Session::new();
+    let mut buffer = String::new();
+    let mut ok = true;
+    let mut lines = input.lines();
+    loop {
+        let line = match lines.next() {
+            Some(Ok(l)) => l,
+            Some(Err(e)) => {
+                let _ = writeln!(out, "error: cannot read input: {e}");
+                return false;
+            }
+            None => break,
+        };
+        buffer.push_str(&line);
+        buffer.push('\n');
+        if !session.is_complete(&buffer) {
+            continue;
+        }
+        let reply = session.handle(&buffer);
+        buffer.clear();
+        match reply {
+            Reply::Quit => return ok,
+            Reply::Output(s) if s.is_empty() => {}
+            Reply::Output(s) => {
+                let _ = writeln!(out, "{s}");
+            }
+            Reply::Error(s) => {
+                ok = false;
+                let _ = write!(out, "{s}{}", if s.ends_with('\n') { "" } else { "\n" });
+            }
+        }
+    }
+    if !buffer.trim().is_empty() {
+        let _ = writeln!(
+            out,
+            "error: the input ended inside an unfinished statement:\n{buffer}"
+        );
+        ok = false;
+    }
+    ok
+}

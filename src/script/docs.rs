@@ -1,0 +1,116 @@
+//! The help text of every script-visible name: what `:help NAME` shows. Each entry has a runnable
+//! example (tests run them all, and check that every registered function has an entry).
+
+/// One documented name.
+#[derive(Debug, Clone, Copy)]
+pub struct Doc {
+    /// The name as typed (a function, a method, or a property).
+    pub name: &'static str,
+    /// Group shown by `:help`.
+    pub group: &'static str,
+    /// Call forms.
+    pub signature: &'static str,
+    /// What it does.
+    pub about: &'static str,
+    /// A runnable example.
+    pub example: &'static str,
+}
+
+macro_rules! doc {
+    ($name:literal, $group:literal, $sig:literal, $about:literal, $ex:expr) => {
+        Doc {
+            name: $name,
+            group: $group,
+            signature: $sig,
+            about: $about,
+            example: $ex,
+        }
+    };
+}
+
+/// Every documented name.
+pub const DOCS: &[Doc] = &[
+    doc!("scene", "building", "scene() -> Scene", "An empty scene: no swimmers, mu = 1e-3 Pa s, model \"micro\", mobility \"rpy\", default integrator.", "let s = scene(); print(s);"),
+    doc!("dumbbell", "building", "dumbbell() -> Dumbbell\ndumbbell(#{ a1, a2, ell, lambda, omega, k0, phase, center, dir }) -> Dumbbell", "A swimmer description (SI units). Every key is optional; defaults are the paper's symmetric Fig-1 swimmer (a1 = a2 = 0.15 ell, ell = 5e-6 m, lambda = 0.1 ell, omega = 500 1/s, k0 = 1e-3 kg/s^2, phase 0, at the origin, along +x). Unknown keys are errors.", "let d = dumbbell(#{ a1: 1.125e-6, a2: 0.5625e-6, phase: 0.5 }); print(d.a2);"),
+    doc!("add", "building", "s.add(d: Dumbbell) -> int", "Add a swimmer at length L(t) of the scene's time, its hydrodynamic centre at d.center, pointing along d.dir; returns its 0-based index. Refuses overlapping swimmers.", "let s = scene(); let i = s.add(dumbbell()); print(i);"),
+    doc!("copy", "building", "s.copy() -> Scene", "An independent copy of the scene (same state, no recorders). `let t = s;` would name the same scene.", "let s = scene(); let t = s.copy(); t.add(dumbbell()); print(s.count);"),
+    doc!("phase", "phases", "phase(x) -> float\ns.phase(i) -> float", "phase(x): x radians wrapped to [0, 2 pi). s.phase(i): the stroke phase of swimmer i.", "print(phase(7.0)); let s = scene(); s.add(dumbbell(#{ phase: 1.0 })); print(s.phase(0));"),
+    doc!("phase_deg", "phases", "phase_deg(x) -> float", "x degrees as radians in [0, 2 pi).", "print(phase_deg(90));"),
+    doc!("phases", "phases", "s.phases -> array\ns.phases = [..]", "All stroke phases (rad) in swimmer order; assign one per swimmer.", PAIR_PHASES),
+    doc!("set_phase", "phases", "s.set_phase(i, phi)", "Set the stroke phase of swimmer i (rad).", "let s = scene(); s.add(dumbbell()); s.set_phase(0, pi()); print(s.phases);"),
+    doc!("model", "numerics", "s.model -> string\ns.model = \"micro\" | \"averaged\"", "The model: \"micro\" (spheres, springs, mobility) or \"averaged\" (stroke-averaged R_H and N). Switching converts the state.", "let s = scene(); s.add(dumbbell()); s.model = \"averaged\"; print(s.model);"),
+    doc!("mobility", "numerics", "s.mobility -> string\ns.mobility = \"rpy\" | \"oseen\"", "Pair mobility of the microscopic model: Rotne-Prager-Yamakawa (default) or Oseen.", "let s = scene(); s.mobility = \"oseen\"; print(s.mobility);"),
+    doc!("coefficients", "numerics", "s.coefficients -> string\ns.coefficients = \"paper\" | \"leading_order\"", "Coefficients of the averaged model's I and J terms: as published, or the leading-order ones.", "let s = scene(); s.coefficients = \"leading_order\"; print(s.coefficients);"),
+    doc!("integrator", "numerics", "s.integrator -> Integrator\ns.integrator = euler(dt) | rk4(dt) | dopri5(rtol) | \"default\"", "The time integrator. The default depends on the model and the scene's stiffness.", "let s = scene(); s.add(dumbbell()); print(s.integrator); s.integrator = rk4(5e-6); print(s.integrator);"),
+    doc!("euler", "numerics", "euler(dt) -> Integrator", "Forward Euler with steps of at most dt seconds.", "let i = euler(1e-6); print(i);"),
+    doc!("rk4", "numerics", "rk4(dt) -> Integrator", "Classic Runge-Kutta 4 with steps of at most dt seconds.", "let i = rk4(5e-6); print(i);"),
+    doc!("dopri5", "numerics", "dopri5(rtol) -> Integrator", "Adaptive Dormand-Prince 5(4); rtol is relative to the stroke and drift scales, not to positions.", "let i = dopri5(1e-8); print(i);"),
+    doc!("mu", "numerics", "s.mu -> float\ns.mu = x", "Viscosity (Pa s).", "let s = scene(); s.mu = 2e-3; print(s.mu);"),
+    doc!("stiff_rate", "numerics", "s.stiff_rate -> float", "The largest spring relaxation rate k0 (1/gamma1 + 1/gamma2) (1/s); explicit steps need dt below ~2.8/rate.", "let s = scene(); s.add(dumbbell()); print(s.stiff_rate);"),
+    doc!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
+    doc!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
+    doc!("time", "running", "s.time -> float", "Current time (s).", "let s = scene(); print(s.time);"),
+    doc!("period", "running", "s.period -> float", "The common stroke period (s).", "let s = scene(); s.add(dumbbell()); print(s.period);"),
+    doc!("count", "running", "s.count -> int", "Number of swimmers.", "let s = scene(); print(s.count);"),
+    doc!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations.", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
+    doc!("center", "reading", "s.center(i) -> [x, y, z]", "Hydrodynamic centre R_H of swimmer i (m).", "let s = scene(); s.add(dumbbell()); print(s.center(0));"),
+    doc!("dir", "reading", "s.dir(i) -> [x, y, z]", "Unit orientation N of swimmer i (from the a1 sphere to the a2 sphere).", "let s = scene(); s.add(dumbbell(#{ dir: [0, 1, 0] })); print(s.dir(0));"),
+    doc!("velocity", "reading", "s.velocity(i) -> [x, y, z]", "dR_H/dt of swimmer i now (m/s).", PAIR_VELOCITY),
+    doc!("spin", "reading", "s.spin(i) -> [x, y, z]", "dN/dt of swimmer i now (1/s).", "let s = scene(); s.add(dumbbell()); print(s.spin(0));"),
+    doc!("length", "reading", "s.length(i) -> float\nlength(i) -> Observable", "Length |X2 - X1| of swimmer i (m); as a global function, the observable.", "let s = scene(); s.add(dumbbell()); print(s.length(0)); print(length(0));"),
+    doc!("swimmer", "reading", "s.swimmer(i) -> Dumbbell", "Parameters and current pose of swimmer i.", "let s = scene(); s.add(dumbbell()); print(s.swimmer(0));"),
+    doc!("observe", "observables", "s.observe(obs) -> float | array", "Evaluate an observable now.", "let s = scene(); s.add(dumbbell()); print(s.observe(R_H(0)));"),
+    doc!("R_H", "observables", "R_H(i) -> Observable", "Hydrodynamic centre of swimmer i (m).", "print(R_H(0));"),
+    doc!("R_G", "observables", "R_G(i) -> Observable", "Geometric centre (X1 + X2)/2 of swimmer i (m).", "print(R_G(0));"),
+    doc!("N", "observables", "N(i) -> Observable", "Unit orientation of swimmer i.", "print(N(0));"),
+    doc!("tension", "observables", "tension(i) -> Observable", "Spring tension k0 (d - L) of swimmer i (N), microscopic model.", "print(tension(0));"),
+    doc!("pair_mean", "observables", "pair_mean(i, j) -> Observable\npair_mean(i, j, axis) -> Observable", "(R_H^i + R_H^j)/2 along axis (default x) (m).", "print(pair_mean(0, 1, [0, 0, 1]));"),
+    doc!("pair_separation", "observables", "pair_separation(i, j) -> Observable\npair_separation(i, j, axis) -> Observable", "R_H^j - R_H^i along axis (default x) (m).", "print(pair_separation(0, 1));"),
+    doc!("q", "observables", "q(i, j) -> Observable", "q = N^i . N^j.", "print(q(0, 1));"),
+    doc!("D_H", "observables", "D_H(i, j) -> Observable", "Distance |R_H^i - R_H^j| (m).", "print(D_H(0, 1));"),
+    doc!("delta_q", "observables", "delta_q(i, j) -> Observable", "q(0) - q(T) over the next period, measured on a copy (the scene is not advanced).", PAIR_DELTA_Q),
+    doc!("delta_D_H", "observables", "delta_D_H(i, j) -> Observable", "[D_H(0) - D_H(T)]/ell over the next period, on a copy; > 0: approaching.", "print(delta_D_H(0, 1));"),
+    doc!("polarization", "observables", "polarization() -> Observable", "|<N>| over all swimmers.", "let s = scene(); s.add(dumbbell()); print(s.observe(polarization()));"),
+    doc!("nematic", "observables", "nematic() -> Observable", "Largest eigenvalue of Q = <3NN - I>/2.", "let s = scene(); s.add(dumbbell()); print(s.observe(nematic()));"),
+    doc!("record", "recording", "s.record([obs, ...], every) -> Recorder", "Record observables on a trigger: a number (every n periods), every_periods(n), every_seconds(t), at_times([..]) or at_end(). Periodic recorders take a row at once. Only the recorded observables are evaluated, only at their times.", PAIR_RECORD),
+    doc!("every_periods", "recording", "every_periods(n) -> Trigger", "Every n periods from now.", "print(every_periods(2));"),
+    doc!("every_seconds", "recording", "every_seconds(t) -> Trigger", "Every t seconds from now.", "print(every_seconds(1e-3));"),
+    doc!("at_times", "recording", "at_times([t1, t2, ...]) -> Trigger", "At the given absolute times (s).", "print(at_times([0.01, 0.02]));"),
+    doc!("at_end", "recording", "at_end() -> Trigger", "At the end of every run.", "print(at_end());"),
+    doc!("rows", "recording", "rec.rows -> array of maps", "The recorded rows, keyed by column name (time, R_H[0].x, ...).", PAIR_ROWS),
+    doc!("columns", "recording", "rec.columns -> array\nrec.header -> array\nrec.column(name) -> array", "Column names (without / with units) and one column's values.", PAIR_COLUMNS),
+    doc!("to_csv", "recording", "rec.to_csv(path)", "Write the rows as CSV; the header carries names and units. Folders are created.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); s.run_periods(1); r.to_csv(\"out/help/r.csv\");"),
+    doc!("save", "files", "s.save(path)", "Save the whole scene (swimmers, phases, model, integrator, time, state) as JSON; load_scene reads it back exactly. Recorders are not saved; an adaptive integrator restarts its step-size control after loading.", "let s = scene(); s.add(dumbbell()); s.save(\"out/help/scene.json\"); let t = load_scene(\"out/help/scene.json\"); print(t.count);"),
+    doc!("load_scene", "files", "load_scene(path) -> Scene", "A scene saved with s.save(path).", "let s = scene(); s.save(\"out/help/empty.json\"); print(load_scene(\"out/help/empty.json\"));"),
+    doc!("write_csv", "files", "write_csv(path, rows)\nwrite_csv(path, columns, rows)", "Write an array of maps as CSV (columns in the given order, or sorted).", "write_csv(\"out/help/t.csv\", [\"D\", \"v\"], [#{ D: 10.0, v: 1e-6 }]);"),
+    doc!("sci", "formatting", "sci(x) -> string\nsci(x, digits) -> string", "Scientific notation.", "print(sci(1.23456e-7, 2));"),
+    doc!("fixed", "formatting", "fixed(x, digits) -> string", "Fixed-point notation.", "print(fixed(3.14159, 2));"),
+    doc!("lpad", "formatting", "lpad(x, width) -> string", "Right-align x in width characters.", "print(lpad(42, 6));"),
+    doc!("rpad", "formatting", "rpad(x, width) -> string", "Left-align x in width characters.", "print(rpad(\"D\", 6) + \"|\");"),
+    doc!("pi", "formatting", "pi() -> float", "The number pi.", "print(pi());"),
+    doc!("quick", "formatting", "quick() -> bool", "True under `swimlab run --quick` (or SWIMLAB_QUICK=1): long scripts run a short variant.", "let n = if quick() { 1 } else { 100 }; print(n);"),
+    doc!("is_number", "formatting", "is_number(x) -> bool", "Whether x is an integer or a float.", "print(is_number(1e-6));"),
+    doc!("a1", "swimmer properties", "d.a1 -> float", "Radius of sphere 1 (m); N points from it to sphere 2.", "print(dumbbell().a1);"),
+    doc!("a2", "swimmer properties", "d.a2 -> float", "Radius of sphere 2 (m).", "print(dumbbell(#{ a2: 1e-6 }).a2);"),
+    doc!("ell", "swimmer properties", "d.ell -> float", "Mean length (m).", "print(dumbbell().ell);"),
+    doc!("lambda", "swimmer properties", "d.lambda -> float", "Stroke amplitude (m).", "print(dumbbell().lambda);"),
+    doc!("omega", "swimmer properties", "d.omega -> float", "Angular frequency (1/s).", "print(dumbbell().omega);"),
+    doc!("k0", "swimmer properties", "d.k0 -> float", "Spring constant (kg/s^2).", "print(dumbbell().k0);"),
+    doc!("name", "observables", "obs.name -> string\nobs.unit -> string", "An observable's name (its column prefix) and unit.", "print(q(0, 1).name); print(R_H(0).unit);"),
+    doc!("unit", "observables", "obs.unit -> string", "An observable's unit (m, N, ell, or 1).", "print(D_H(0, 1).unit);"),
+    doc!("len", "recording", "rec.len -> int", "Number of rows recorded.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); s.run_periods(2); print(r.len);"),
+    doc!("header", "recording", "rec.header -> array", "Column names with units, as written to CSV.", PAIR_COLUMNS),
+    doc!("column", "recording", "rec.column(name) -> array", "One column's values.", PAIR_COLUMNS),
+];
+
+const PAIR_PHASES: &str = "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [25e-6, 0, 0] })); s.phases = [0.0, phase_deg(90)]; print(s.phases);";
+const PAIR_VELOCITY: &str = "let s = scene(); s.add(dumbbell(#{ center: [-25e-6, 0, 0] })); s.add(dumbbell(#{ phase: pi() / 2.0, center: [25e-6, 0, 0] })); s.model = \"averaged\"; print(s.velocity(0));";
+const PAIR_DELTA_Q: &str = "let s = scene(); s.add(dumbbell(#{ center: [-25e-6, 0, 0] })); s.add(dumbbell(#{ phase: pi() / 2.0, center: [25e-6, 0, 0], dir: [0, 1, 0] })); print(s.observe(delta_q(0, 1)));";
+const PAIR_RECORD: &str = "let s = scene(); s.add(dumbbell(#{ center: [-25e-6, 0, 0] })); s.add(dumbbell(#{ phase: pi() / 2.0, center: [25e-6, 0, 0] })); let rec = s.record([pair_mean(0, 1), pair_separation(0, 1)], 1); s.run_periods(2); print(rec);";
+const PAIR_ROWS: &str = "let s = scene(); s.add(dumbbell()); let rec = s.record([R_H(0)], 1); s.run_periods(1); print(rec.rows[1].time);";
+const PAIR_COLUMNS: &str = "let s = scene(); s.add(dumbbell()); let rec = s.record([q(0, 0)], at_end()); s.run_periods(1); print(rec.columns); print(rec.header); print(rec.column(\"q[0,0]\"));";
+
+/// The entry for `name`.
+pub fn lookup(name: &str) -> Option<&'static Doc> {
+    DOCS.iter().find(|d| d.name == name)
+}

@@ -1,0 +1,34 @@
+//! Docs that are run cannot rot: every `:help` example runs, and every function a script can call
+//! has a help entry.
+
+use rhai::Scope;
+use swimlab::script::{docs::DOCS, engine, run_source};
+
+#[test]
+fn every_help_example_runs() {
+    for d in DOCS {
+        run_source(&format!(":help {}", d.name), d.example, &mut Scope::new())
+            .unwrap_or_else(|e| panic!("example of {} fails:\n{e}", d.name));
+    }
+}
+
+#[test]
+fn every_registered_name_has_help() {
+    // Conversion and display hooks Rhai calls itself are not user vocabulary.
+    let internal = ["to_string", "to_debug"];
+    let mut missing = Vec::new();
+    for sig in engine().gen_fn_signatures(false) {
+        let name = sig.split('(').next().unwrap();
+        let name = name.trim_start_matches("get$").trim_start_matches("set$");
+        let is_ident = name
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_alphabetic() || c == '_');
+        if is_ident && !internal.contains(&name) && !DOCS.iter().any(|d| d.name == name) {
+            missing.push(name.to_string());
+        }
+    }
+    missing.sort();
+    missing.dedup();
+    assert!(missing.is_empty(), "no :help entry for {missing:?}");
+}

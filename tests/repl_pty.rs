@@ -1,0 +1,71 @@
+//! The shell through a real pseudo-terminal, as a transcript: what only a terminal shows (line
+//! editing, completion, continuation lines, Ctrl-C and Ctrl-D). The logic itself is tested below
+//! the terminal in `repl_session.rs`; this file stays small.
+
+use expectrl::session::OsSession as Session;
+use expectrl::{ControlCode, Eof, Expect};
+use std::process::Command;
+use std::time::Duration;
+
+/// A fresh prompt starts a line (after any terminal control sequences); rustyline's redraws of the
+/// line being edited start with `\r` instead.
+const PROMPT: expectrl::Regex<&str> = expectrl::Regex("\n(\x1b\\[[0-9;?]*[a-zA-Z]|\r)*swimlab> ");
+
+fn start() -> Session {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_swimlab"));
+    let hist = std::env::temp_dir().join(format!("swimlab-pty-history-{}", std::process::id()));
+    cmd.env("SWIMLAB_HISTORY", hist).env("TERM", "xterm");
+    let mut s = Session::spawn(cmd).expect("spawn swimlab in a pty");
+    s.set_expect_timeout(Some(Duration::from_secs(20)));
+    s.expect(PROMPT).unwrap();
+    s
+}
+
+/// Send a line and wait for `expect` and then the next prompt.
+#[track_caller]
+fn step(s: &mut Session, send: &str, expect: &str) {
+    s.send_line(send).unwrap();
+    if !expect.is_empty() {
+        s.expect(expect)
+            .unwrap_or_else(|e| panic!("after {send:?}: expected {expect:?}: {e}"));
+    }
+    s.expect(PROMPT)
+        .unwrap_or_else(|e| panic!("after {send:?}: no prompt: {e}"));
+}
+
+#[test]
+fn transcript_of_a_session() {
+    let mut s = start();
+    step(&mut s, "1 + 2", "=> 3");
+    // A multi-line function: the parser asks for more until the block closes.
+    s.send_line("fn twice(v) {").unwrap();
+    s.send_line("  2 * v").unwrap();
+    step(&mut s, "}", "");
+    step(&mut s, "twice(21)", "=> 42");
+    // Completion: "sce" + Tab completes to "scene".
+    s.send("let s = sce\t").unwrap();
+    step(&mut s, "();", "");
+    step(&mut s, "s.count", "=> 0");
+    step(&mut s, ":help rk4", "Classic Runge-Kutta 4");
+    // An error keeps the session.
+    step(&mut s, "s.model = \"fast\";", "unknown model");
+    step(&mut s, "s.add(dumbbell(#{ center: [-25e-6, 0, 0] })); s.add(dumbbell(#{ phase: 1.0, center: [25e-6, 0, 0] }));", "");
+    let rec = "let rec = s.record([pair_mean(0, 1)], 1);";
+    step(&mut s, rec, "");
+    // Ctrl-C during a long run stops it at a step boundary and keeps the scene and the rows.
+    s.send_line("s.run_periods(1000000);").unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    s.send(ControlCode::EndOfText).unwrap();
+    s.expect("run interrupted at t =").unwrap();
+    s.expect(PROMPT).unwrap();
+    step(
+        &mut s,
+        "s.time > 0.0 && s.count == 2 && rec.len > 1",
+        "=> true",
+    );
+    // Ctrl-C at an empty prompt does not leave; Ctrl-D does.
+    s.send(ControlCode::EndOfText).unwrap();
+    s.expect("Ctrl-D or :quit leaves").unwrap();
+    s.send(ControlCode::EndOfTransmission).unwrap();
+    s.expect(Eof).expect("Ctrl-D ends the session");
+}

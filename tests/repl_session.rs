@@ -1,0 +1,113 @@
+//! The shell's logic below the terminal: state across inputs, shown values, commands, errors that
+//! keep the session, multi-line detection by Rhai's parser, and piped input.
+
+use swimlab::repl::{piped, Reply, Session};
+
+fn out(s: &mut Session, input: &str) -> String {
+    match s.handle(input) {
+        Reply::Output(o) => o,
+        other => panic!("{input:?}: {other:?}"),
+    }
+}
+
+#[test]
+fn variables_and_functions_persist_and_expression_values_are_shown() {
+    let mut s = Session::new();
+    assert_eq!(out(&mut s, "let x = 2;"), "");
+    assert_eq!(out(&mut s, "fn twice(v) {\n  2 * v\n}"), "");
+    assert_eq!(out(&mut s, "twice(x) + 1"), "=> 5");
+    assert_eq!(out(&mut s, "let sc = scene(); sc.add(dumbbell());"), "");
+    assert!(out(&mut s, "sc").starts_with("=> Scene(1 swimmers"));
+    assert_eq!(out(&mut s, "sc.count;"), "", "a trailing ; hides the value");
+    assert!(out(&mut s, ":vars").contains("let sc: Scene = Scene(1 swimmers"));
+}
+
+#[test]
+fn errors_show_a_caret_and_keep_the_session_and_the_scene() {
+    let mut s = Session::new();
+    out(&mut s, "let sc = scene(); sc.add(dumbbell());");
+    match s.handle("sc.add(dumbbell(#{ radius: 1e-6 }));") {
+        Reply::Error(e) => {
+            assert!(e.contains("unknown dumbbell key \"radius\""), "{e}");
+            assert!(e.contains('^'), "{e}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(out(&mut s, "sc.count"), "=> 1");
+}
+
+#[test]
+fn multi_line_input_is_detected_by_the_parser() {
+    let s = Session::new();
+    for incomplete in [
+        "fn f(x) {",
+        "let a = [1,",
+        "sc.run(",
+        "let m = #{ a: 1,",
+        "let x = 1 +",
+        "if true {\n  print(1);",
+    ] {
+        assert!(!s.is_complete(incomplete), "{incomplete:?} should continue");
+    }
+    for complete in [
+        "print(1)",
+        "let x = (1 + ;",
+        ":help",
+        "",
+        "fn f(x) {\n x\n}",
+    ] {
+        assert!(
+            s.is_complete(complete),
+            "{complete:?} is complete (or a real error)"
+        );
+    }
+}
+
+#[test]
+fn help_lists_everything_and_shows_one_name() {
+    let mut s = Session::new();
+    let all = out(&mut s, ":help");
+    for name in ["scene", "dumbbell", "run_periods", "record", "R_H", ":load"] {
+        assert!(all.contains(name), "{name} missing from :help");
+    }
+    let one = out(&mut s, ":help run_periods");
+    assert!(
+        one.contains("s.run_periods(n)") && one.contains("example:"),
+        "{one}"
+    );
+    match s.handle(":help run_period") {
+        Reply::Error(e) => assert!(e.contains("did you mean \"run_periods\""), "{e}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn load_clear_and_quit() {
+    let mut s = Session::new();
+    assert!(matches!(s.handle(":load no/such.rhai"), Reply::Error(_)));
+    let dir = std::env::temp_dir().join(format!("swimlab-repl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("def.rhai");
+    std::fs::write(&f, "let loaded = 41;\nfn inc(v) { v + 1 }\n").unwrap();
+    out(&mut s, &format!(":load {}", f.display()));
+    assert_eq!(out(&mut s, "inc(loaded)"), "=> 42");
+    out(&mut s, ":clear");
+    assert!(matches!(s.handle("loaded"), Reply::Error(_)));
+    assert_eq!(s.handle(":quit"), Reply::Quit);
+}
+
+#[test]
+fn piped_input_runs_line_by_line_and_reports_failure() {
+    let input =
+        "let s = scene();\nfn f(x) {\n  x * 2\n}\nf(21)\ns.mobility = \"stokes\";\ns.mobility\n";
+    let mut buf = Vec::new();
+    let ok = piped(input.as_bytes(), &mut buf);
+    let text = String::from_utf8(buf).unwrap();
+    assert!(!ok, "an error makes the piped session fail");
+    assert!(text.contains("=> 42"), "{text}");
+    assert!(text.contains("unknown mobility"), "{text}");
+    assert!(
+        text.contains("=> \"rpy\""),
+        "the session went on after the error: {text}"
+    );
+}
