@@ -111,3 +111,12 @@ fn piped_input_runs_line_by_line_and_reports_failure() {
         "the session went on after the error: {text}"
     );
 }
+
+#[test]
+fn imports_stay_for_later_inputs() {
+    let mut s = Session::new();
+    assert_eq!(out(&mut s, "import \"paper\" as paper;"), "");
+    assert_eq!(out(&mut s, "let sc = paper::mirror(10.0, true, true);"), "");
+    assert_eq!(out(&mut s, "sc.count"), "=> 2");
+    assert_eq!(out(&mut s, "paper::ell()"), "=> 5e-6");
+}

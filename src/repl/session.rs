@@ -19,6 +19,8 @@ pub enum Reply {
 /// An interactive session: engine, variables, and the functions defined so far.
 pub struct Session {
     engine: Engine,
+    /// The same module resolution the engine does, for keeping imports (see `keep_imports`).
+    resolver: rhai::module_resolvers::ModuleResolversCollection,
     scope: Scope<'static>,
     functions: AST,
     inputs: usize,
@@ -47,8 +49,10 @@ const COMMANDS: &[(&str, &str)] = &[
 impl Session {
     /// A fresh session.
     pub fn new() -> Self {
+        let engine = script::engine();
         Session {
-            engine: script::engine(),
+            resolver: script::stdlib::resolver(&engine),
+            engine,
             scope: Scope::new(),
             functions: AST::empty(),
             inputs: 0,
@@ -96,6 +100,9 @@ impl Session {
         // Keep the functions even when the statements failed: they were defined.
         self.functions = merged;
         self.functions.clear_statements();
+        if result.is_ok() {
+            self.keep_imports(source);
+        }
         // As in IPython and Julia, a trailing `;` means "don't show the value".
         let quiet = source.trim_end().ends_with(';');
         match result {
@@ -157,6 +164,27 @@ impl Session {
                     .collect::<Vec<_>>()
                     .join(", ")
             )),
+        }
+    }
+
+    /// Rhai forgets `import "x" as y;` after the evaluation it appears in; a session keeps it by
+    /// registering the resolved module under its alias on the session's engine.
+    fn keep_imports(&mut self, source: &str) {
+        for stmt in source.split(';') {
+            let words: Vec<&str> = stmt.split_whitespace().collect();
+            if let ["import", path, "as", alias] = words.as_slice() {
+                let path = path.trim_matches('"');
+                let resolved = rhai::ModuleResolver::resolve(
+                    &self.resolver,
+                    &self.engine,
+                    None,
+                    path,
+                    rhai::Position::NONE,
+                );
+                if let Ok(module) = resolved {
+                    self.engine.register_static_module(*alias, module);
+                }
+            }
         }
     }
 

@@ -90,6 +90,7 @@ pub const DOCS: &[Doc] = &[
     doc!("pi", "formatting", "pi() -> float", "The number pi.", "print(pi());"),
     doc!("quick", "formatting", "quick() -> bool", "True under `swimlab run --quick` (or SWIMLAB_QUICK=1): long scripts run a short variant.", "let n = if quick() { 1 } else { 100 }; print(n);"),
     doc!("is_number", "formatting", "is_number(x) -> bool", "Whether x is an integer or a float.", "print(is_number(1e-6));"),
+    doc!("uniform_randoms", "formatting", "uniform_randoms(n, seed) -> array", "n reproducible uniform numbers in [0, 1) (splitmix64).", "print(uniform_randoms(3, 42));"),
     doc!("a1", "swimmer properties", "d.a1 -> float", "Radius of sphere 1 (m); N points from it to sphere 2.", "print(dumbbell().a1);"),
     doc!("a2", "swimmer properties", "d.a2 -> float", "Radius of sphere 2 (m).", "print(dumbbell(#{ a2: 1e-6 }).a2);"),
     doc!("ell", "swimmer properties", "d.ell -> float", "Mean length (m).", "print(dumbbell().ell);"),

@@ -13,6 +13,7 @@ mod observable_api;
 mod render;
 mod scene_api;
 mod show;
+pub mod stdlib;
 mod util_api;
 
 pub use convert::{script_error, ScriptResult};
