@@ -134,30 +134,38 @@ impl OdeSystem for MicroSystem {
         let mut pos = std::mem::take(&mut self.pos);
         self.sphere_positions(y, &mut pos);
         self.pos = pos;
-        let pos = &self.pos;
-        let n = pos.len();
-        for a in 0..n {
-            for b in (a + 1)..n {
-                let gap = (pos[a] - pos[b]).norm() - self.radii[a] - self.radii[b];
-                if gap <= 0.0 {
-                    let (sa, sb) = (a / 2, b / 2);
-                    let cause = if sa == sb {
-                        format!("the two spheres of swimmer {sa} overlap (gap {gap:.3e} m)")
-                    } else {
-                        format!(
-                            "sphere {} of swimmer {sa} overlaps sphere {} of swimmer {sb} (gap {gap:.3e} m)",
-                            a % 2 + 1,
-                            b % 2 + 1
-                        )
-                    };
-                    return Err(Problem {
-                        swimmer: Some(sa),
-                        cause,
-                        hint: "start the swimmers further apart, or use a smaller time step if the overlap came from a step that was too large".into(),
-                    });
-                }
-            }
+        if let Some(p) = first_overlap(&self.pos, &self.radii) {
+            return Err(p);
         }
         Ok(())
     }
+}
+
+/// The first pair of overlapping spheres (sphere 2σ has radius a1, 2σ+1 radius a2), as a problem
+/// naming the swimmers.
+pub(crate) fn first_overlap(pos: &[Vector3<f64>], radii: &[f64]) -> Option<Problem> {
+    let n = pos.len();
+    for a in 0..n {
+        for b in (a + 1)..n {
+            let gap = (pos[a] - pos[b]).norm() - radii[a] - radii[b];
+            if gap <= 0.0 {
+                let (sa, sb) = (a / 2, b / 2);
+                let cause = if sa == sb {
+                    format!("the two spheres of swimmer {sa} overlap (gap {gap:.3e} m)")
+                } else {
+                    format!(
+                        "sphere {} of swimmer {sa} overlaps sphere {} of swimmer {sb} (gap {gap:.3e} m)",
+                        a % 2 + 1,
+                        b % 2 + 1
+                    )
+                };
+                return Some(Problem {
+                    swimmer: Some(sa),
+                    cause,
+                    hint: "start the swimmers further apart, or use a smaller time step if the overlap came from a step that was too large".into(),
+                });
+            }
+        }
+    }
+    None
 }

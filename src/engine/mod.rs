@@ -12,6 +12,7 @@ pub mod mobility;
 pub mod model;
 pub mod observable;
 pub mod recorder;
+pub mod rigid;
 pub mod scene;
 pub mod swimmer;
 

@@ -6,7 +6,7 @@
 //!   position of size ~10ℓ every step would round it at ~1e-15·10ℓ per step, a systematic error of up to
 //!   1e-4 of the drift over a period of ~1,000 steps. A displacement stays small and rounds far below.
 //! - `y[6σ+3..6σ+6]`: the microscopic model's dumbbell vector b = X₂ − X₁ (m); the averaged model's
-//!   unit orientation N.
+//!   unit orientation N, and so the rigid-stroke model's (whose length is L(t)).
 
 use super::error::{invalid, Result};
 use nalgebra::Vector3;
@@ -24,6 +24,8 @@ pub enum Model {
     Micro,
     /// Stroke-averaged R_H and N per swimmer (e:eom … e:eom_last).
     Averaged,
+    /// The microscopic model in the rigid-stroke limit k0 → ∞: lengths follow L(t) exactly.
+    Rigid,
 }
 
 impl Model {
@@ -32,8 +34,9 @@ impl Model {
         match name {
             "micro" => Ok(Model::Micro),
             "averaged" => Ok(Model::Averaged),
+            "rigid" => Ok(Model::Rigid),
             other => Err(invalid!(
-                "unknown model \"{other}\"; use \"micro\" (spheres and springs, default) or \"averaged\" (stroke-averaged R_H and N)"
+                "unknown model \"{other}\"; use \"micro\" (spheres and springs, default), \"rigid\" (spheres, lengths prescribed) or \"averaged\" (stroke-averaged R_H and N)"
             )),
         }
     }
@@ -43,6 +46,7 @@ impl Model {
         match self {
             Model::Micro => "micro",
             Model::Averaged => "averaged",
+            Model::Rigid => "rigid",
         }
     }
 }

@@ -1,8 +1,7 @@
 //! Named quantities that can be measured on a scene now ([`Observable::evaluate`]) or recorded on a
 //! trigger ([`super::recorder`]). Each knows its name, its components and their unit.
 
-use super::error::{invalid, Result};
-use super::model::Model;
+use super::error::Result;
 use super::scene::Scene;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use serde::{Deserialize, Serialize};
@@ -129,15 +128,7 @@ impl Observable {
             }
             Observable::Dir(i) => v3(s.dir(i)?),
             Observable::Length(i) => vec![s.length(i)?],
-            Observable::Tension(i) => {
-                if s.model() != Model::Micro {
-                    return Err(invalid!(
-                        "tension({i}) exists only in the microscopic model (the averaged model has no springs); set s.model = \"micro\""
-                    ));
-                }
-                let d = s.swimmer(i)?;
-                vec![d.k0 * (s.length(i)? - d.rest_length(s.time()))]
-            }
+            Observable::Tension(i) => vec![s.tension(i)?],
             Observable::PairMean(i, j, axis) => {
                 // Displacements first: the mean of two large positions would round the drift.
                 let base =

@@ -8,6 +8,7 @@ use super::micro::MicroSystem;
 use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
 use super::recorder::Recorder;
+use super::rigid::RigidSystem;
 use super::swimmer::{unit_direction, Dumbbell};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -23,6 +24,8 @@ pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
 /// The default step never exceeds this fraction of the shortest period, so that soft springs
 /// (small k0) still resolve the stroke.
 pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
+/// Default tolerance of the rigid-stroke model's adaptive integrator (README, "work-precision").
+pub const DEFAULT_RIGID_RTOL: f64 = 1e-7;
 /// Default tolerance of the averaged model's adaptive integrator.
 pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 
@@ -150,7 +153,7 @@ impl Scene {
         self.base.push(center);
         let v = match self.model {
             Model::Micro => n * len,
-            Model::Averaged => n,
+            Model::Averaged | Model::Rigid => n,
         };
         self.state
             .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
@@ -184,7 +187,7 @@ impl Scene {
             let i = STATE_PER_SWIMMER * s + 3;
             let v = vec3(&self.state, i);
             let new = match model {
-                Model::Averaged => v.normalize(),
+                Model::Averaged | Model::Rigid => v.normalize(),
                 Model::Micro => v * d.rest_length(self.time),
             };
             set_vec3(&mut self.state, i, &new);
@@ -239,6 +242,9 @@ impl Scene {
             }
             Model::Averaged => IntegratorSpec::Dopri5 {
                 rtol: DEFAULT_AVERAGED_RTOL,
+            },
+            Model::Rigid => IntegratorSpec::Dopri5 {
+                rtol: DEFAULT_RIGID_RTOL,
             },
         }
     }
@@ -411,7 +417,7 @@ impl Scene {
         self.check_index(i)?;
         Ok(match self.model {
             Model::Micro => vec3(&self.state, STATE_PER_SWIMMER * i + 3).norm(),
-            Model::Averaged => self.swimmers[i].rest_length(self.time),
+            Model::Averaged | Model::Rigid => self.swimmers[i].rest_length(self.time),
         })
     }
 
@@ -422,7 +428,26 @@ impl Scene {
         let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
         match self.model {
             Model::Micro => (rh - d.w2() * v, rh + d.w1() * v),
-            Model::Averaged => d.sphere_positions(rh, v, d.rest_length(self.time)),
+            Model::Averaged | Model::Rigid => d.sphere_positions(rh, v, d.rest_length(self.time)),
+        }
+    }
+
+    /// Spring tension k0 (d − L) of swimmer `i` (N), or the constraint tension in the rigid-stroke
+    /// model; positive when the spring pulls the spheres together.
+    pub fn tension(&self, i: usize) -> Result<f64> {
+        self.check_index(i)?;
+        match self.model {
+            Model::Micro => {
+                let d = &self.swimmers[i];
+                Ok(d.k0 * (self.length(i)? - d.rest_length(self.time)))
+            }
+            Model::Rigid => {
+                let mut sys = RigidSystem::new(&self.swimmers, &self.base, self.mu, self.mobility);
+                Ok(sys.tensions(self.time, &self.state)[i])
+            }
+            Model::Averaged => Err(invalid!(
+                "tension({i}) does not exist in the averaged model (it has no springs); set s.model = \"micro\" or \"rigid\""
+            )),
         }
     }
 
@@ -436,7 +461,7 @@ impl Scene {
         let v = vec3(&dy, k);
         let w = vec3(&dy, k + 3);
         let spin = match self.model {
-            Model::Averaged => w,
+            Model::Averaged | Model::Rigid => w,
             Model::Micro => {
                 let b = vec3(&self.state, k + 3);
                 let n = b.normalize();
@@ -454,6 +479,12 @@ impl Scene {
     fn system(&self) -> Result<Box<dyn OdeSystem>> {
         Ok(match self.model {
             Model::Micro => Box::new(MicroSystem::new(
+                &self.swimmers,
+                &self.base,
+                self.mu,
+                self.mobility,
+            )),
+            Model::Rigid => Box::new(RigidSystem::new(
                 &self.swimmers,
                 &self.base,
                 self.mu,

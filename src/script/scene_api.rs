@@ -113,7 +113,7 @@ pub fn register(engine: &mut Engine) {
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let name = string_arg("model", &v)?;
                 let m = Model::parse(&name)
-                    .map_err(|_| unknown_choice("model", &name, &["micro", "averaged"]))?;
+                    .map_err(|_| unknown_choice("model", &name, &["micro", "rigid", "averaged"]))?;
                 s.0.borrow_mut().set_model(m);
                 Ok(())
             },

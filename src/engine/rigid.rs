@@ -1,0 +1,167 @@
+//! The rigid-stroke limit of the microscopic model (k0 → ∞): each dumbbell's length follows
+//! L(t) = ℓ + λ sin(ωt + φ) exactly, and the spring tensions become constraint forces.
+//!
+//! State per swimmer as in the averaged model: ΔR_H and unit N (the length is known). With
+//! tension T_τ on dumbbell τ (force +T N on sphere 1, −T N on sphere 2), the velocity of every
+//! sphere is linear in the tensions, and the constraint d(|X₂ − X₁|)/dt = L̇ for every dumbbell is an
+//! S×S linear system A T = L̇ with
+//! A_στ = N_σ · [(H_{2σ,1τ} − H_{1σ,1τ}) − (H_{2σ,2τ} − H_{1σ,2τ})] N_τ.
+//! Then, as in the spring model, dR_H/dt = (a1 u₁ + a2 u₂)/(a1+a2) (the drag parts cancel exactly)
+//! and dN/dt = (I − NNᵀ)(u₂ − u₁)/L, u the interaction velocities. Nothing is stiff any more: the
+//! step is set by the stroke, not by the spring.
+
+use super::integrators::{OdeSystem, Problem};
+use super::micro::first_overlap;
+use super::mobility::{self_mobility, Mobility};
+use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
+use super::swimmer::Dumbbell;
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// The rigid-stroke right-hand side with its scratch buffers.
+#[derive(Debug, Clone)]
+pub struct RigidSystem {
+    swimmers: Vec<Dumbbell>,
+    base: Vec<Vector3<f64>>,
+    mu: f64,
+    mobility: Mobility,
+    radii: Vec<f64>,
+    pos: Vec<Vector3<f64>>,
+    forces: Vec<Vector3<f64>>,
+    u: Vec<Vector3<f64>>,
+    a: DMatrix<f64>,
+    rate: DVector<f64>,
+}
+
+impl RigidSystem {
+    /// A system for these swimmers, base positions, viscosity and mobility.
+    pub fn new(swimmers: &[Dumbbell], base: &[Vector3<f64>], mu: f64, mobility: Mobility) -> Self {
+        let n = 2 * swimmers.len();
+        let s = swimmers.len();
+        RigidSystem {
+            swimmers: swimmers.to_vec(),
+            base: base.to_vec(),
+            mu,
+            mobility,
+            radii: swimmers.iter().flat_map(|d| [d.a1, d.a2]).collect(),
+            pos: vec![Vector3::zeros(); n],
+            forces: vec![Vector3::zeros(); n],
+            u: vec![Vector3::zeros(); n],
+            a: DMatrix::zeros(s, s),
+            rate: DVector::zeros(s),
+        }
+    }
+
+    fn place(&mut self, t: f64, y: &[f64]) {
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let rh = self.base[s] + vec3(y, STATE_PER_SWIMMER * s);
+            let n = vec3(y, STATE_PER_SWIMMER * s + 3);
+            let (x1, x2) = d.sphere_positions(rh, n, d.rest_length(t));
+            self.pos[2 * s] = x1;
+            self.pos[2 * s + 1] = x2;
+        }
+    }
+
+    /// H_αβ v for spheres α, β (self term when α = β).
+    fn h(&self, alpha: usize, beta: usize, v: &Vector3<f64>) -> Vector3<f64> {
+        if alpha == beta {
+            v * self_mobility(self.mu, self.radii[alpha])
+        } else {
+            let r = self.pos[alpha] - self.pos[beta];
+            self.mobility
+                .pair_apply(self.mu, &r, self.radii[alpha], self.radii[beta], v)
+        }
+    }
+
+    /// The constraint tensions at time `t` (N), in swimmer order.
+    pub fn tensions(&mut self, t: f64, y: &[f64]) -> Vec<f64> {
+        self.place(t, y);
+        self.solve(t, y);
+        self.rate.iter().copied().collect()
+    }
+
+    /// Fill `self.rate` with the tensions (solving A T = L̇).
+    fn solve(&mut self, t: f64, y: &[f64]) {
+        let s_count = self.swimmers.len();
+        let n: Vec<Vector3<f64>> = (0..s_count)
+            .map(|s| vec3(y, STATE_PER_SWIMMER * s + 3))
+            .collect();
+        for sg in 0..s_count {
+            for tau in 0..s_count {
+                let (i1, i2, j1, j2) = (2 * sg, 2 * sg + 1, 2 * tau, 2 * tau + 1);
+                let nt = n[tau];
+                let rel = (self.h(i2, j1, &nt) - self.h(i1, j1, &nt))
+                    - (self.h(i2, j2, &nt) - self.h(i1, j2, &nt));
+                self.a[(sg, tau)] = n[sg].dot(&rel);
+            }
+            let d = &self.swimmers[sg];
+            self.rate[sg] = d.lambda * d.omega * (d.omega * t + d.phase).cos();
+        }
+        // A is diagonally dominant (drag ≫ interaction for non-overlapping spheres): LU is safe.
+        let lu = self.a.clone().lu();
+        if let Some(tension) = lu.solve(&self.rate) {
+            self.rate = tension;
+        } else {
+            self.rate.fill(f64::NAN);
+        }
+    }
+}
+
+impl OdeSystem for RigidSystem {
+    fn dim(&self) -> usize {
+        STATE_PER_SWIMMER * self.swimmers.len()
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.place(t, y);
+        self.solve(t, y);
+        for s in 0..self.swimmers.len() {
+            let f = self.rate[s] * vec3(y, STATE_PER_SWIMMER * s + 3);
+            self.forces[2 * s] = f;
+            self.forces[2 * s + 1] = -f;
+        }
+        self.mobility.interaction_velocities(
+            self.mu,
+            &self.pos,
+            &self.radii,
+            &self.forces,
+            &mut self.u,
+        );
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let (u1, u2) = (self.u[2 * s], self.u[2 * s + 1]);
+            let n = vec3(y, STATE_PER_SWIMMER * s + 3);
+            let drh = d.w1() * u1 + d.w2() * u2;
+            let rel = u2 - u1;
+            let dn = (rel - n * n.dot(&rel)) / d.rest_length(t);
+            set_vec3(dy, STATE_PER_SWIMMER * s, &drh);
+            set_vec3(dy, STATE_PER_SWIMMER * s + 3, &dn);
+        }
+    }
+
+    /// As the spring model: centres against the closest pair's drift scale, orientations against
+    /// the stroke's relative size λ/ℓ.
+    fn error_scale(&self, _y: &[f64], scale: &mut [f64]) {
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let stroke = d.lambda.max(0.01 * d.ell);
+            let drift = stroke * (stroke / d.ell).powi(2) * (d.big_lambda() / d.ell);
+            let i = STATE_PER_SWIMMER * s;
+            scale[i..i + 3].fill(drift);
+            scale[i + 3..i + 6].fill(stroke / d.ell);
+        }
+    }
+
+    fn check(&mut self, t: f64, y: &[f64]) -> Result<(), Problem> {
+        self.place(t, y);
+        match first_overlap(&self.pos, &self.radii) {
+            Some(p) => Err(p),
+            None => Ok(()),
+        }
+    }
+
+    fn project(&self, y: &mut [f64]) {
+        for s in 0..self.swimmers.len() {
+            let i = STATE_PER_SWIMMER * s + 3;
+            let n = vec3(y, i).normalize();
+            set_vec3(y, i, &n);
+        }
+    }
+}
