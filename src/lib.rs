@@ -6,6 +6,7 @@
 // Numerical kernels index several arrays in lockstep; an index loop says that most plainly.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bench;
 pub mod engine;
 pub mod repl;
 pub mod script;

@@ -28,6 +28,15 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Benchmarks: work against precision, stability limits. Tables are printed and written as CSV
+    /// to out/bench/.
+    Bench {
+        #[command(subcommand)]
+        which: BenchKind,
+        /// A short version (fewer methods and repeats).
+        #[arg(long, global = true)]
+        quick: bool,
+    },
     /// Run an experiment script (without FILE: the built-in Fig-1 pair experiment, scripts/pair.rhai).
     Run {
         /// The .rhai script to run.
@@ -40,6 +49,58 @@ enum Command {
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
     },
+}
+
+#[derive(Subcommand)]
+enum BenchKind {
+    /// Every integrator on the Fig-1 pairs over 100 periods: error of drift and separation change
+    /// against a converged reference, wall time (median of 5), right-hand sides, steps, Pareto front.
+    WorkPrecision,
+    /// Largest stable step of each explicit method against 2/rate and 2.785/rate.
+    Stability,
+}
+
+fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
+    use swimlab::bench::{stability, work_precision};
+    use swimlab::engine::Model;
+    let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
+    match which {
+        BenchKind::WorkPrecision => {
+            let (periods, repeats) = if quick { (5.0, 1) } else { (100.0, 5) };
+            for (label, models, file) in [
+                (
+                    "microscopic model (spring and rigid-stroke)",
+                    vec![Model::Micro, Model::Rigid],
+                    "work_precision_micro.csv",
+                ),
+                (
+                    "averaged model",
+                    vec![Model::Averaged],
+                    "work_precision_averaged.csv",
+                ),
+            ] {
+                let points = work_precision::run(&models, periods, repeats, quick);
+                let t = work_precision::table(&points);
+                println!("\n{label}, {periods} periods (errors relative to the converged reference; * = Pareto front):\n{}", t.render());
+                println!(
+                    "\nfastest method per error level of the drift:\n{}",
+                    work_precision::winners(&points).render()
+                );
+                t.write_csv(&std::path::Path::new("out/bench").join(file))
+                    .map_err(io)?;
+            }
+            println!("\nCSV written to out/bench/");
+        }
+        BenchKind::Stability => {
+            let rows = stability::run(quick);
+            let t = stability::table(&rows);
+            println!("largest stable step (bisection on dt*rate, 4 periods of an isolated asymmetric dumbbell):\n{}", t.render());
+            t.write_csv(std::path::Path::new("out/bench/stability.csv"))
+                .map_err(io)?;
+            println!("\nCSV written to out/bench/stability.csv");
+        }
+    }
+    Ok(())
 }
 
 /// Parse `NAME=VALUE` into a Rhai constant.
@@ -85,6 +146,7 @@ fn main() -> ExitCode {
         }
     } else {
         match cli.command {
+            Some(Command::Bench { which, quick }) => bench(which, quick),
             Some(Command::Run { file, quick, set }) => {
                 if quick {
                     // Read by `quick()` in scripts; set before any other thread exists.
