@@ -134,15 +134,12 @@ impl AveragedSystem {
                 }
             }
         }
-        let stroke = |d: &Dumbbell| d.lambda.max(0.01 * d.ell);
         let mut sys = AveragedSystem {
-            scale_r: swimmers
-                .iter()
-                .map(|d| stroke(d) * (stroke(d) / d.ell).powi(2) * (d.big_lambda() / d.ell))
-                .collect(),
+            scale_r: swimmers.iter().map(Dumbbell::drift_scale).collect(),
+            // The matching rotation scale (λ/ℓ)²(Λ/ℓ).
             scale_n: swimmers
                 .iter()
-                .map(|d| (stroke(d) / d.ell).powi(2) * (d.big_lambda() / d.ell))
+                .map(|d| d.drift_scale() / d.stroke_scale())
                 .collect(),
             coef,
             base: base.to_vec(),

@@ -96,15 +96,12 @@ impl OdeSystem for MicroSystem {
     }
 
     /// The dumbbell vector is measured against the stroke λ (its oscillation), the centre against
-    /// λ·(λ/ℓ)²·(Λ/ℓ), the order of the net displacement per period of the closest possible pair: the
-    /// drift is second order in λ/ℓ and first in Λ/ℓ, so this is the size of what the run is after.
+    /// the drift scale λ(λ/ℓ)²(Λ/ℓ) ([`Dumbbell::drift_scale`]).
     fn error_scale(&self, _y: &[f64], scale: &mut [f64]) {
         for (s, d) in self.swimmers.iter().enumerate() {
-            let stroke = d.lambda.max(0.01 * d.ell);
-            let drift = stroke * (stroke / d.ell).powi(2) * (d.big_lambda() / d.ell);
             let i = STATE_PER_SWIMMER * s;
-            scale[i..i + 3].fill(drift);
-            scale[i + 3..i + 6].fill(stroke);
+            scale[i..i + 3].fill(d.drift_scale());
+            scale[i + 3..i + 6].fill(d.stroke_scale());
         }
     }
 

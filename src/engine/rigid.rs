@@ -137,11 +137,9 @@ impl OdeSystem for RigidSystem {
     /// the stroke's relative size λ/ℓ.
     fn error_scale(&self, _y: &[f64], scale: &mut [f64]) {
         for (s, d) in self.swimmers.iter().enumerate() {
-            let stroke = d.lambda.max(0.01 * d.ell);
-            let drift = stroke * (stroke / d.ell).powi(2) * (d.big_lambda() / d.ell);
             let i = STATE_PER_SWIMMER * s;
-            scale[i..i + 3].fill(drift);
-            scale[i + 3..i + 6].fill(stroke / d.ell);
+            scale[i..i + 3].fill(d.drift_scale());
+            scale[i + 3..i + 6].fill(d.stroke_scale() / d.ell);
         }
     }
 

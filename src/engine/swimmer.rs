@@ -98,6 +98,20 @@ impl Dumbbell {
         self.a1 == self.a2
     }
 
+    /// Size of the stroke that error control compares the dumbbell vector with: λ, but at least
+    /// 1% of ℓ so a passive dumbbell (λ = 0) still has a scale (m).
+    pub fn stroke_scale(&self) -> f64 {
+        self.lambda.max(0.01 * self.ell)
+    }
+
+    /// Size of the net displacement per period of the closest possible pair, λ(λ/ℓ)²(Λ/ℓ) (m): the
+    /// drift is second order in λ/ℓ and first in Λ/ℓ, so this is what error control on R_H is
+    /// measured against, never the absolute position.
+    pub fn drift_scale(&self) -> f64 {
+        let stroke = self.stroke_scale();
+        stroke * (stroke / self.ell).powi(2) * (self.big_lambda() / self.ell)
+    }
+
     /// Relaxation rate of the spring, k0 (1/γ1 + 1/γ2) with γ = 6πμa (1/s): the stiff rate.
     pub fn relaxation_rate(&self, mu: f64) -> f64 {
         self.k0 / (6.0 * PI * mu) * (1.0 / self.a1 + 1.0 / self.a2)
