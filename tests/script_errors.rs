@@ -164,3 +164,25 @@ fn a_step_that_blows_up_stops_with_time_cause_and_last_good_state() {
 fn parse_errors_show_the_position() {
     expect("let s = scene();\nlet x = (1 + ;", 2, &[]);
 }
+
+#[test]
+fn an_adaptive_step_that_fails_a_guard_is_retried_smaller() {
+    use nalgebra::Vector3;
+    use swimlab::engine::scene::never;
+    use swimlab::engine::{Dumbbell, IntegratorSpec, Scene};
+    // A loose tolerance lets dopri5 propose steps far above the spring's stability limit; the
+    // guards reject the resulting runaway springs, the step is retried smaller, and the run
+    // completes with a physical state.
+    let mut s = Scene::new();
+    s.add(Dumbbell::default(), Vector3::zeros(), Vector3::x())
+        .unwrap();
+    s.set_integrator(Some(IntegratorSpec::Dopri5 { rtol: 0.5 }));
+    s.run_periods(2.0, &never).unwrap();
+    let d = *s.swimmer(0).unwrap();
+    assert!((s.length(0).unwrap() - d.rest_length(s.time())).abs() < 0.5 * d.ell);
+    let st = s.stats();
+    assert!(
+        st.rejected_by_guard > 0,
+        "the guards must have rejected steps: {st:?}"
+    );
+}

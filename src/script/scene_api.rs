@@ -299,6 +299,10 @@ pub fn register(engine: &mut Engine) {
             m.insert("steps".into(), (st.steps as INT).into());
             m.insert("rejected".into(), (st.rejected as INT).into());
             m.insert("rhs_evals".into(), (st.rhs_evals as INT).into());
+            m.insert(
+                "rejected_by_guard".into(),
+                (st.rejected_by_guard as INT).into(),
+            );
             m
         });
 }

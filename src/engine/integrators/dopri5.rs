@@ -224,6 +224,7 @@ impl Stepper for Dopri5 {
                 }
                 (true, Err(failure)) => {
                     stats.rejected += 1;
+                    stats.rejected_by_guard += 1;
                     rejects += 1;
                     if rejects >= MAX_REJECTS {
                         self.h = Some(h_try);

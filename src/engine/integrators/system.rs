@@ -48,6 +48,9 @@ pub struct Stats {
     pub rejected: u64,
     /// Right-hand-side evaluations.
     pub rhs_evals: u64,
+    /// Of the rejected attempts, those whose state failed a guard (NaN, overlap, runaway spring).
+    #[serde(default)]
+    pub rejected_by_guard: u64,
 }
 
 /// One time-stepping method.
