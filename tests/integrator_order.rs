@@ -3,7 +3,7 @@
 //! y₁' = y₂, y₂' = −y₁ − 0.1 y₂ + cos t, integrated to t = 3 and compared with a 10⁻¹³-accurate
 //! reference; plus the adaptive method's error tracking its tolerance.
 
-use swimlab::engine::integrators::{Dopri5, Euler, OdeSystem, Rk4, Stats, Stepper};
+use swimlab::engine::integrators::{Dopri5, Euler, OdeSystem, Rk4, Rosenbrock, Stats, Stepper};
 
 struct Forced;
 impl OdeSystem for Forced {
@@ -16,6 +16,26 @@ impl OdeSystem for Forced {
     }
     fn error_scale(&self, _y: &[f64], scale: &mut [f64]) {
         scale.fill(1.0);
+    }
+    fn jacobian_block(&self) -> usize {
+        2
+    }
+    fn jacobian_blocks(&mut self, _t: f64, _y: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(&[0.0, 1.0, -1.0, -0.1]);
+    }
+}
+
+/// The same problem offering no Jacobian: a W-method must keep its order with J = 0.
+struct ForcedNoJacobian;
+impl OdeSystem for ForcedNoJacobian {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        Forced.rhs(t, y, dy)
+    }
+    fn error_scale(&self, y: &[f64], scale: &mut [f64]) {
+        Forced.error_scale(y, scale)
     }
 }
 
@@ -34,13 +54,15 @@ fn exact(t: f64) -> [f64; 2] {
 }
 
 fn error(stepper: &mut dyn Stepper, t_end: f64) -> f64 {
+    error_on(&mut Forced, stepper, t_end)
+}
+
+fn error_on(sys: &mut dyn OdeSystem, stepper: &mut dyn Stepper, t_end: f64) -> f64 {
     let mut y = [1.0, 0.0];
     let mut t = 0.0;
     let mut stats = Stats::default();
     while t < t_end {
-        t = stepper
-            .step(&mut Forced, t, &mut y, t_end, &mut stats)
-            .unwrap();
+        t = stepper.step(sys, t, &mut y, t_end, &mut stats).unwrap();
     }
     let e = exact(t_end);
     ((y[0] - e[0]).powi(2) + (y[1] - e[1]).powi(2)).sqrt()
@@ -80,4 +102,23 @@ fn adaptive_dormand_prince_error_follows_its_tolerance() {
     assert!(e1 / e2 > 100.0, "errors {e1:e} -> {e2:e}");
     // And the error is of the order of the tolerance times the solution size (~10).
     assert!(e2 < 1e-8 * 10.0 * 100.0, "error {e2:e}");
+}
+
+#[test]
+fn rosenbrock_w_is_third_order_with_the_jacobian_and_without_it() {
+    let p = observed_order(|h| Box::new(Rosenbrock::fixed_step(h)), 0.05);
+    assert!((p - 3.0).abs() < 0.15, "with J: observed order {p}");
+    // The W property: any matrix in place of J, here none, keeps the order.
+    let e1 = error_on(
+        &mut ForcedNoJacobian,
+        &mut Rosenbrock::fixed_step(0.05),
+        3.0,
+    );
+    let e2 = error_on(
+        &mut ForcedNoJacobian,
+        &mut Rosenbrock::fixed_step(0.025),
+        3.0,
+    );
+    let p0 = (e1 / e2).log2();
+    assert!((p0 - 3.0).abs() < 0.2, "without J: observed order {p0}");
 }

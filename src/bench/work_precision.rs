@@ -99,6 +99,9 @@ pub fn methods(model: Model, period: f64, quick: bool) -> Vec<IntegratorSpec> {
             for r in [1e-4, 1e-6, 1e-8] {
                 v.push(IntegratorSpec::Dopri5 { rtol: r });
             }
+            for r in [1e-5, 1e-6, 1e-7] {
+                v.push(IntegratorSpec::Rosw { rtol: r });
+            }
         }
         Model::Rigid => {
             for n in [20.0, 50.0, 100.0] {

@@ -62,6 +62,19 @@ impl MicroSystem {
     }
 }
 
+impl MicroSystem {
+    /// The rates of dumbbell `d` alone with vector `b` at time `t`: its spring, its drag and its
+    /// own spheres' hydrodynamic interaction: the stiff part of the dynamics. With f the force on
+    /// sphere 1 and H = H₁₂(b): dR_H/dt = (w2 − w1) H f, db/dt = −(1/γ1 + 1/γ2) f + 2 H f.
+    fn own_rates(&self, d: &Dumbbell, t: f64, b: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let len = b.norm();
+        let f = d.k0 * (len - d.rest_length(t)) / len * b;
+        let hf = self.mobility.pair_apply(self.mu, b, d.a1, d.a2, &f);
+        let drag = self_mobility(self.mu, d.a1) + self_mobility(self.mu, d.a2);
+        ((d.w2() - d.w1()) * hf, -drag * f + 2.0 * hf)
+    }
+}
+
 impl OdeSystem for MicroSystem {
     fn dim(&self) -> usize {
         STATE_PER_SWIMMER * self.swimmers.len()
@@ -92,6 +105,32 @@ impl OdeSystem for MicroSystem {
             let db = -(self_mobility(self.mu, d.a1) + self_mobility(self.mu, d.a2)) * f + u2 - u1;
             set_vec3(dy, STATE_PER_SWIMMER * s, &drh);
             set_vec3(dy, STATE_PER_SWIMMER * s + 3, &db);
+        }
+    }
+
+    fn jacobian_block(&self) -> usize {
+        STATE_PER_SWIMMER
+    }
+
+    /// Per dumbbell, ∂(own rates)/∂(ΔR_H, b) by central differences: the own rates do not depend on
+    /// the position (columns 0-2 vanish); the b columns carry the spring's stiffness.
+    fn jacobian_blocks(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
+        let n = STATE_PER_SWIMMER;
+        out.fill(0.0);
+        for (s, d) in self.swimmers.iter().enumerate() {
+            let b = vec3(y, n * s + 3);
+            let delta = 1e-6 * b.norm();
+            let block = &mut out[s * n * n..(s + 1) * n * n];
+            for q in 0..3 {
+                let mut e = Vector3::zeros();
+                e[q] = delta;
+                let (rp, bp) = self.own_rates(d, t, &(b + e));
+                let (rm, bm) = self.own_rates(d, t, &(b - e));
+                for r in 0..3 {
+                    block[r * n + 3 + q] = (rp[r] - rm[r]) / (2.0 * delta);
+                    block[(r + 3) * n + 3 + q] = (bp[r] - bm[r]) / (2.0 * delta);
+                }
+            }
         }
     }
 

@@ -1,4 +1,4 @@
-//! `euler(dt)`, `rk4(dt)`, `dopri5(rtol)`: integrator choices as script values (type `Integrator`).
+//! `euler(dt)`, `rk4(dt)`, `dopri5(rtol)`, `rosw(rtol)`: integrator choices as script values (type `Integrator`).
 
 use super::convert::{lift, number, ScriptResult};
 use crate::engine::IntegratorSpec;
@@ -24,6 +24,9 @@ pub fn register(engine: &mut Engine) {
         })
         .register_fn("dopri5", |r: Dynamic| {
             make(IntegratorSpec::dopri5, "dopri5(rtol): rtol", r)
+        })
+        .register_fn("rosw", |r: Dynamic| {
+            make(IntegratorSpec::rosw, "rosw(rtol): rtol", r)
         })
         .register_fn("to_string", |i: &mut IntegratorSpec| i.to_string())
         .register_fn("to_debug", |i: &mut IntegratorSpec| i.to_string())

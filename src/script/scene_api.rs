@@ -156,7 +156,7 @@ pub fn register(engine: &mut Engine) {
                     }
                     Ok(name) => Err(unknown_choice("integrator", &name, &["default"])),
                     Err(t) => Err(script_error(format!(
-                        "integrator must be euler(dt), rk4(dt), dopri5(rtol) or \"default\", got {v} ({t})"
+                        "integrator must be euler(dt), rk4(dt), dopri5(rtol), rosw(rtol) or \"default\", got {v} ({t})"
                     ))),
                 }
             },

@@ -8,11 +8,13 @@
 mod dopri5;
 mod euler;
 mod rk4;
+mod rosenbrock;
 mod spec;
 mod system;
 
 pub use dopri5::Dopri5;
 pub use euler::Euler;
 pub use rk4::Rk4;
+pub use rosenbrock::Rosenbrock;
 pub use spec::IntegratorSpec;
 pub use system::{OdeSystem, Problem, Stats, StepFailure, Stepper};

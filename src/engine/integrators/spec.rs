@@ -1,6 +1,6 @@
 //! The user's choice of integrator, as saved with a scene.
 
-use super::{Dopri5, Euler, Rk4, Stepper};
+use super::{Dopri5, Euler, Rk4, Rosenbrock, Stepper};
 use crate::engine::error::{require_positive, Result};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -22,6 +22,11 @@ pub enum IntegratorSpec {
     /// Adaptive Dormand-Prince 5(4) with relative tolerance `rtol`.
     Dopri5 {
         /// Relative tolerance (of the drift-sized error scale, see the models).
+        rtol: f64,
+    },
+    /// Adaptive Rosenbrock-W ROS34PW2 (stiff; implicit in each dumbbell's own dynamics).
+    Rosw {
+        /// Relative tolerance (as for dopri5).
         rtol: f64,
     },
 }
@@ -50,12 +55,21 @@ impl IntegratorSpec {
         Ok(IntegratorSpec::Dopri5 { rtol })
     }
 
+    /// Rosenbrock-W ROS34PW2, checked: 1e-14 ≤ rtol < 1.
+    pub fn rosw(rtol: f64) -> Result<Self> {
+        match Self::dopri5(rtol)? {
+            IntegratorSpec::Dopri5 { rtol } => Ok(IntegratorSpec::Rosw { rtol }),
+            other => Ok(other),
+        }
+    }
+
     /// A fresh stepper for this spec.
     pub fn build(&self) -> Box<dyn Stepper> {
         match *self {
             IntegratorSpec::Euler { dt } => Box::new(Euler::new(dt)),
             IntegratorSpec::Rk4 { dt } => Box::new(Rk4::new(dt)),
             IntegratorSpec::Dopri5 { rtol } => Box::new(Dopri5::new(rtol)),
+            IntegratorSpec::Rosw { rtol } => Box::new(Rosenbrock::new(rtol)),
         }
     }
 }
@@ -66,6 +80,7 @@ impl fmt::Display for IntegratorSpec {
             IntegratorSpec::Euler { dt } => write!(f, "euler({dt:e})"),
             IntegratorSpec::Rk4 { dt } => write!(f, "rk4({dt:e})"),
             IntegratorSpec::Dopri5 { rtol } => write!(f, "dopri5({rtol:e})"),
+            IntegratorSpec::Rosw { rtol } => write!(f, "rosw({rtol:e})"),
         }
     }
 }

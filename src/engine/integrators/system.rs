@@ -17,6 +17,14 @@ pub trait OdeSystem {
     }
     /// Map a state back onto its manifold after a step (e.g. renormalise unit vectors).
     fn project(&self, _y: &mut [f64]) {}
+    /// Size of the diagonal blocks of the approximate Jacobian [`OdeSystem::jacobian_blocks`]
+    /// offers (0: none; linearly implicit methods then treat the system as non-stiff).
+    fn jacobian_block(&self) -> usize {
+        0
+    }
+    /// The diagonal blocks of (an approximation to) ∂f/∂y at (t, y), row-major, one after another.
+    /// The models put the stiff part there: each dumbbell's own spring, drag and hydrodynamics.
+    fn jacobian_blocks(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) {}
 }
 
 /// What made a state unacceptable.

@@ -1,0 +1,288 @@
+//! ROS34PW2 (Rang & Angermann, BIT 45, 2005): a 4-stage, third-order, L-stable Rosenbrock-W method
+//! with an embedded second-order solution, for stiff systems.
+//!
+//! A W-method keeps its order with *any* matrix in place of the Jacobian. swimlab uses that: the
+//! models offer the block-diagonal part of ∂f/∂y that holds the stiffness (each dumbbell's own
+//! spring, drag and hydrodynamics, [`OdeSystem::jacobian_blocks`]), and the hydrodynamic coupling
+//! between dumbbells stays explicit. A step then costs four right-hand sides (O(S²)), one more for
+//! ∂f/∂t, the blocks by finite differences of each dumbbell alone (O(S)), and S small LU solves per
+//! stage (O(S)): no dense 6S×6S algebra, and no step limit from the spring.
+//!
+//! Stage equations (Hairer & Wanner, IV.7, with k including the factor h):
+//! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
+
+use super::system::{check_state, Problem, StepFailure};
+use super::{OdeSystem, Stats, Stepper};
+use nalgebra::{DMatrix, DVector};
+
+const GAMMA: f64 = 4.358_665_215_084_59e-1;
+const A: [[f64; 3]; 4] = [
+    [0.0, 0.0, 0.0],
+    [8.717_330_430_169_18e-1, 0.0, 0.0],
+    [8.445_706_001_536_942e-1, -1.129_906_423_648_418_5e-1, 0.0],
+    [0.0, 0.0, 1.0],
+];
+/// Off-diagonal Γ (the diagonal is GAMMA).
+const G: [[f64; 3]; 4] = [
+    [0.0, 0.0, 0.0],
+    [-8.717_330_430_169_18e-1, 0.0, 0.0],
+    [-9.033_805_701_304_408e-1, 5.418_067_238_809_533e-2, 0.0],
+    [
+        2.421_238_070_609_534_6e-1,
+        -1.223_250_583_904_514_7,
+        5.452_602_553_351_021e-1,
+    ],
+];
+const B: [f64; 4] = [
+    2.421_238_070_609_534_6e-1,
+    -1.223_250_583_904_514_7,
+    1.545_260_255_335_102,
+    4.358_665_215_084_59e-1,
+];
+const B_EMBEDDED: [f64; 4] = [
+    3.781_090_314_581_937e-1,
+    -9.604_229_221_242_318e-2,
+    0.5,
+    2.179_332_607_542_295e-1,
+];
+const MAX_REJECTS: u32 = 60;
+
+/// Adaptive ROS34PW2 with relative tolerance `rtol` (against [`OdeSystem::error_scale`]), or with
+/// fixed steps for convergence studies.
+#[derive(Debug, Clone)]
+pub struct Rosenbrock {
+    rtol: f64,
+    fixed: Option<f64>,
+    h: Option<f64>,
+    k: [Vec<f64>; 4],
+    f: Vec<f64>,
+    f0: Vec<f64>,
+    ft: Vec<f64>,
+    tmp: Vec<f64>,
+    acc: Vec<f64>,
+    y_new: Vec<f64>,
+    scale: Vec<f64>,
+    jac: Vec<f64>,
+    /// LU factors of W = I − hγJ per block, for the step size being tried.
+    lus: Vec<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+}
+
+impl Rosenbrock {
+    /// An adaptive stepper with relative tolerance `rtol`.
+    pub fn new(rtol: f64) -> Self {
+        Rosenbrock {
+            rtol,
+            fixed: None,
+            h: None,
+            k: Default::default(),
+            f: Vec::new(),
+            f0: Vec::new(),
+            ft: Vec::new(),
+            tmp: Vec::new(),
+            acc: Vec::new(),
+            y_new: Vec::new(),
+            scale: Vec::new(),
+            jac: Vec::new(),
+            lus: Vec::new(),
+        }
+    }
+
+    /// Fixed steps of at most `dt`, no error control (for order studies).
+    pub fn fixed_step(dt: f64) -> Self {
+        Rosenbrock {
+            fixed: Some(dt),
+            ..Rosenbrock::new(1.0)
+        }
+    }
+
+    /// One attempt with step h from (t, y): fills y_new, returns the error norm.
+    fn attempt(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        bs: usize,
+        stats: &mut Stats,
+    ) -> f64 {
+        let n = y.len();
+        let gamma_hat = |i: usize| GAMMA + G[i].iter().sum::<f64>();
+        let c = |i: usize| A[i].iter().sum::<f64>();
+        for i in 0..4 {
+            // Stage argument and Γ-combination of the earlier stages.
+            for m in 0..n {
+                let mut ya = y[m];
+                let mut ga = 0.0;
+                for j in 0..i {
+                    ya += A[i][j] * self.k[j][m];
+                    ga += G[i][j] * self.k[j][m];
+                }
+                self.tmp[m] = ya;
+                self.acc[m] = ga;
+            }
+            if i == 0 {
+                self.f.copy_from_slice(&self.f0);
+            } else {
+                sys.rhs(t + c(i) * h, &self.tmp, &mut self.f);
+                stats.rhs_evals += 1;
+            }
+            // rhs = h f + h J acc + h² γ̂ᵢ f_t, then solve blockwise with W = I − hγJ.
+            let gh = gamma_hat(i);
+            for blk in 0..(n.checked_div(bs).unwrap_or(0)) {
+                let o = blk * bs;
+                let jb = &self.jac[blk * bs * bs..(blk + 1) * bs * bs];
+                let mut rhs = DVector::zeros(bs);
+                for r in 0..bs {
+                    let mut jv = 0.0;
+                    for q in 0..bs {
+                        jv += jb[r * bs + q] * self.acc[o + q];
+                    }
+                    rhs[r] = h * self.f[o + r] + h * jv + h * h * gh * self.ft[o + r];
+                }
+                let sol = self.lus[blk]
+                    .solve(&rhs)
+                    .unwrap_or_else(|| DVector::from_element(bs, f64::NAN));
+                self.k[i][o..o + bs].copy_from_slice(sol.as_slice());
+            }
+            if bs == 0 {
+                for m in 0..n {
+                    self.k[i][m] = h * self.f[m] + h * h * gh * self.ft[m];
+                }
+            }
+        }
+        let mut err = 0.0;
+        for m in 0..n {
+            let mut ynew = y[m];
+            let mut e = 0.0;
+            for i in 0..4 {
+                ynew += B[i] * self.k[i][m];
+                e += (B[i] - B_EMBEDDED[i]) * self.k[i][m];
+            }
+            self.y_new[m] = ynew;
+            let r = e / (self.rtol * self.scale[m]);
+            err += r * r;
+        }
+        (err / n.max(1) as f64).sqrt()
+    }
+}
+
+impl Stepper for Rosenbrock {
+    fn step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure> {
+        let n = y.len();
+        for v in self.k.iter_mut().chain([
+            &mut self.f,
+            &mut self.f0,
+            &mut self.ft,
+            &mut self.tmp,
+            &mut self.acc,
+            &mut self.y_new,
+            &mut self.scale,
+        ]) {
+            v.resize(n, 0.0);
+        }
+        let bs = sys.jacobian_block();
+        if bs > 0 && n % bs != 0 {
+            return Err(StepFailure {
+                time: t,
+                problem: Problem {
+                    swimmer: None,
+                    cause: format!("Jacobian blocks of size {bs} do not tile a state of size {n}"),
+                    hint: "this is a bug in the model; use rk4 or dopri5 meanwhile".into(),
+                },
+            });
+        }
+        sys.error_scale(y, &mut self.scale);
+        sys.rhs(t, y, &mut self.f0);
+        // ∂f/∂t by a forward difference (W-methods need only an approximation).
+        let dt_probe = 1e-7 * (t.abs() + self.h.unwrap_or(1e-6)).max(1e-12);
+        sys.rhs(t + dt_probe, y, &mut self.ft);
+        for m in 0..n {
+            self.ft[m] = (self.ft[m] - self.f0[m]) / dt_probe;
+        }
+        stats.rhs_evals += 2;
+        self.jac.resize(if bs > 0 { n * bs } else { 0 }, 0.0);
+        if bs > 0 {
+            sys.jacobian_blocks(t, y, &mut self.jac);
+        }
+        let mut h = match (self.fixed, self.h) {
+            (Some(dt), _) => super::system::uniform_step(t, t_end, dt).0,
+            (None, Some(h)) => h,
+            (None, None) => (t_end - t).min(1e-3 * (t_end - t).max(1e-9)),
+        };
+        let mut rejects = 0;
+        loop {
+            let span = t_end - t;
+            let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
+            self.lus = (0..n.checked_div(bs).unwrap_or(0))
+                .map(|blk| {
+                    let jb = &self.jac[blk * bs * bs..(blk + 1) * bs * bs];
+                    let w = DMatrix::from_fn(bs, bs, |r, q| {
+                        f64::from(u8::from(r == q)) - h_try * GAMMA * jb[r * bs + q]
+                    });
+                    w.lu()
+                })
+                .collect();
+            let err = self.attempt(sys, t, y, h_try, bs, stats);
+            let t_new = if last { t_end } else { t + h_try };
+            let fixed = self.fixed.is_some();
+            let accept = fixed || (err <= 1.0 && err.is_finite());
+            let guard = if accept {
+                sys.project(&mut self.y_new);
+                check_state(sys, t_new, &self.y_new)
+            } else {
+                Ok(())
+            };
+            let fac = if err.is_finite() && err > 0.0 {
+                (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
+            } else if err == 0.0 {
+                5.0
+            } else {
+                0.2
+            };
+            match (accept, guard) {
+                (true, Ok(())) => {
+                    y.copy_from_slice(&self.y_new);
+                    stats.steps += 1;
+                    let h_next = h_try * fac;
+                    self.h = Some(if last && h_try < h {
+                        h.max(h_next)
+                    } else {
+                        h_next
+                    });
+                    return Ok(t_new);
+                }
+                (true, Err(failure)) => {
+                    stats.rejected += 1;
+                    stats.rejected_by_guard += 1;
+                    rejects += 1;
+                    if fixed || rejects >= MAX_REJECTS {
+                        return Err(failure);
+                    }
+                    h = h_try * 0.25;
+                }
+                (false, _) => {
+                    stats.rejected += 1;
+                    rejects += 1;
+                    if rejects >= MAX_REJECTS {
+                        return Err(StepFailure {
+                            time: t_new,
+                            problem: Problem {
+                                swimmer: None,
+                                cause: format!("the error estimate stayed above tolerance after {MAX_REJECTS} step reductions (h = {h_try:e} s)"),
+                                hint: "loosen the tolerance, or check the scene for nearly touching spheres".into(),
+                            },
+                        });
+                    }
+                    h = h_try * fac.min(0.9);
+                }
+            }
+        }
+    }
+}
