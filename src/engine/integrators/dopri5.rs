@@ -1,7 +1,7 @@
 //! Dormand-Prince 5(4) with embedded error estimate, FSAL, and Hairer's PI step-size controller
 //! (Hairer, Nørsett & Wanner, *Solving ODEs I*, II.4 and the `DOPRI5` code).
 
-use super::system::{check_state, OdeSystem, Stats, StepFailure, Stepper};
+use super::system::{check_state, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
 
 const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
 const A: [[f64; 6]; 7] = [
@@ -236,14 +236,7 @@ impl Stepper for Dopri5 {
                     stats.rejected += 1;
                     rejects += 1;
                     if rejects >= MAX_REJECTS {
-                        return Err(StepFailure {
-                            time: t_new,
-                            problem: super::system::Problem {
-                                swimmer: None,
-                                cause: format!("the error estimate stayed above tolerance after {MAX_REJECTS} step reductions (h = {h_try:e} s)"),
-                                hint: "loosen the tolerance, or check the scene for NaN or nearly touching spheres".into(),
-                            },
-                        });
+                        return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
                     }
                     let shrink = if err_norm.is_finite() {
                         (fac11 / SAFETY).min(1.0 / FAC_MIN)

@@ -11,7 +11,7 @@
 //! Stage equations (Hairer & Wanner, IV.7, with k including the factor h):
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
 
-use super::system::{check_state, Problem, StepFailure};
+use super::system::{check_state, tolerance_failure, Problem, StepFailure};
 use super::{OdeSystem, Stats, Stepper};
 use nalgebra::{DMatrix, DVector};
 
@@ -271,14 +271,7 @@ impl Stepper for Rosenbrock {
                     stats.rejected += 1;
                     rejects += 1;
                     if rejects >= MAX_REJECTS {
-                        return Err(StepFailure {
-                            time: t_new,
-                            problem: Problem {
-                                swimmer: None,
-                                cause: format!("the error estimate stayed above tolerance after {MAX_REJECTS} step reductions (h = {h_try:e} s)"),
-                                hint: "loosen the tolerance, or check the scene for nearly touching spheres".into(),
-                            },
-                        });
+                        return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
                     }
                     h = h_try * fac.min(0.9);
                 }

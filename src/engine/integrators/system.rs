@@ -102,3 +102,19 @@ pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<
     sys.check(t, y)
         .map_err(|problem| StepFailure { time: t, problem })
 }
+
+/// The failure of an adaptive step whose error estimate stayed above tolerance after `rejects`
+/// reductions (shared by the adaptive steppers).
+pub(crate) fn tolerance_failure(time: f64, h: f64, rejects: u32) -> StepFailure {
+    StepFailure {
+        time,
+        problem: Problem {
+            swimmer: None,
+            cause: format!(
+                "the error estimate stayed above tolerance after {rejects} step reductions (h = {h:e} s)"
+            ),
+            hint: "loosen the tolerance, or check the scene for NaN or nearly touching spheres"
+                .into(),
+        },
+    }
+}
