@@ -17,6 +17,15 @@ fn rates(s: &Scene, set: Coefficients, shortcuts: Shortcuts) -> Vec<f64> {
     s.set_model(Model::Averaged);
     let (y, base) = s.raw_state();
     let mut sys = AveragedSystem::with_shortcuts(s.swimmers(), base, set, y, shortcuts);
+    // The 1D path must really be taken whenever it is allowed and the scene is aligned.
+    let aligned = (1..s.count()).all(|i| {
+        let (c, n) = (
+            s.center(i).unwrap() - s.center(0).unwrap(),
+            s.dir(i).unwrap(),
+        );
+        c.y == 0.0 && c.z == 0.0 && n.y == 0.0 && n.z == 0.0
+    }) && s.dir(0).unwrap().x.abs() == 1.0;
+    assert_eq!(sys.is_aligned(), shortcuts.aligned_1d && aligned);
     let mut dy = vec![0.0; y.len()];
     sys.rhs(0.0, y, &mut dy);
     dy

@@ -1,6 +1,5 @@
 //! Plain-text tables and CSV for the benchmarks.
 
-use std::io::Write;
 use std::path::Path;
 
 /// A table of string cells with a header.
@@ -57,7 +56,6 @@ impl Table {
         for r in &self.rows {
             w.write_record(r)?;
         }
-        w.flush()?;
-        std::io::stdout().flush()
+        w.flush()
     }
 }

@@ -10,6 +10,7 @@
 use super::integrators::{OdeSystem, Problem};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
+use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
 
@@ -18,47 +19,27 @@ use nalgebra::Vector3;
 pub struct MicroSystem {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
-    mu: f64,
-    mobility: Mobility,
-    radii: Vec<f64>,
-    pos: Vec<Vector3<f64>>,
-    forces: Vec<Vector3<f64>>,
-    u: Vec<Vector3<f64>>,
+    spheres: Spheres,
 }
 
 impl MicroSystem {
     /// A system for these swimmers, base positions, viscosity and mobility.
     pub fn new(swimmers: &[Dumbbell], base: &[Vector3<f64>], mu: f64, mobility: Mobility) -> Self {
-        let n = 2 * swimmers.len();
         MicroSystem {
             swimmers: swimmers.to_vec(),
             base: base.to_vec(),
-            mu,
-            mobility,
-            radii: swimmers.iter().flat_map(|d| [d.a1, d.a2]).collect(),
-            pos: vec![Vector3::zeros(); n],
-            forces: vec![Vector3::zeros(); n],
-            u: vec![Vector3::zeros(); n],
+            spheres: Spheres::new(swimmers, mu, mobility),
         }
     }
 
-    /// Sphere positions of the state `y` (sphere 2σ has radius a1, 2σ+1 radius a2).
-    pub fn sphere_positions(&self, y: &[f64], out: &mut [Vector3<f64>]) {
+    /// Place the spheres at the state `y`.
+    fn place(&mut self, y: &[f64]) {
         for (s, d) in self.swimmers.iter().enumerate() {
             let rh = self.base[s] + vec3(y, STATE_PER_SWIMMER * s);
             let b = vec3(y, STATE_PER_SWIMMER * s + 3);
-            out[2 * s] = rh - d.w2() * b;
-            out[2 * s + 1] = rh + d.w1() * b;
+            self.spheres.pos[2 * s] = rh - d.w2() * b;
+            self.spheres.pos[2 * s + 1] = rh + d.w1() * b;
         }
-    }
-
-    /// Spring tensions k0 (d − L) of every dumbbell at time `t` (N); positive when stretched.
-    pub fn tensions(&self, t: f64, y: &[f64]) -> Vec<f64> {
-        self.swimmers
-            .iter()
-            .enumerate()
-            .map(|(s, d)| d.k0 * (vec3(y, STATE_PER_SWIMMER * s + 3).norm() - d.rest_length(t)))
-            .collect()
     }
 }
 
@@ -69,8 +50,9 @@ impl MicroSystem {
     fn own_rates(&self, d: &Dumbbell, t: f64, b: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
         let len = b.norm();
         let f = d.k0 * (len - d.rest_length(t)) / len * b;
-        let hf = self.mobility.pair_apply(self.mu, b, d.a1, d.a2, &f);
-        let drag = self_mobility(self.mu, d.a1) + self_mobility(self.mu, d.a2);
+        let sp = &self.spheres;
+        let hf = sp.mobility.pair_apply(sp.mu, b, d.a1, d.a2, &f);
+        let drag = self_mobility(sp.mu, d.a1) + self_mobility(sp.mu, d.a2);
         ((d.w2() - d.w1()) * hf, -drag * f + 2.0 * hf)
     }
 }
@@ -81,28 +63,19 @@ impl OdeSystem for MicroSystem {
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
-        let mut pos = std::mem::take(&mut self.pos);
-        self.sphere_positions(y, &mut pos);
-        self.pos = pos;
-        for (s, d) in self.swimmers.iter().enumerate() {
+        self.place(y);
+        let swimmers = &self.swimmers;
+        self.spheres.interact(|s| {
+            let d = &swimmers[s];
             let b = vec3(y, STATE_PER_SWIMMER * s + 3);
             let len = b.norm();
-            let f = d.k0 * (len - d.rest_length(t)) / len * b;
-            self.forces[2 * s] = f;
-            self.forces[2 * s + 1] = -f;
-        }
-        self.mobility.interaction_velocities(
-            self.mu,
-            &self.pos,
-            &self.radii,
-            &self.forces,
-            &mut self.u,
-        );
+            d.k0 * (len - d.rest_length(t)) / len * b
+        });
+        let sp = &self.spheres;
         for (s, d) in self.swimmers.iter().enumerate() {
-            let (u1, u2) = (self.u[2 * s], self.u[2 * s + 1]);
-            let f = self.forces[2 * s];
-            let drh = d.w1() * u1 + d.w2() * u2;
-            let db = -(self_mobility(self.mu, d.a1) + self_mobility(self.mu, d.a2)) * f + u2 - u1;
+            let drag = self_mobility(sp.mu, d.a1) + self_mobility(sp.mu, d.a2);
+            let drh = sp.center_rate(s, d);
+            let db = -drag * sp.force(s) + sp.relative_rate(s);
             set_vec3(dy, STATE_PER_SWIMMER * s, &drh);
             set_vec3(dy, STATE_PER_SWIMMER * s + 3, &db);
         }
@@ -162,46 +135,15 @@ impl OdeSystem for MicroSystem {
                     ),
                     hint: format!(
                         "use a smaller time step: explicit methods need dt below ~2.8/rate = {:.3e} s here (s.stiff_rate), or the default integrator",
-                        2.785 / d.relaxation_rate(self.mu)
+                        2.785 / d.relaxation_rate(self.spheres.mu)
                     ),
                 });
             }
         }
-        let mut pos = std::mem::take(&mut self.pos);
-        self.sphere_positions(y, &mut pos);
-        self.pos = pos;
-        if let Some(p) = first_overlap(&self.pos, &self.radii) {
-            return Err(p);
-        }
-        Ok(())
-    }
-}
-
-/// The first pair of overlapping spheres (sphere 2σ has radius a1, 2σ+1 radius a2), as a problem
-/// naming the swimmers.
-pub(crate) fn first_overlap(pos: &[Vector3<f64>], radii: &[f64]) -> Option<Problem> {
-    let n = pos.len();
-    for a in 0..n {
-        for b in (a + 1)..n {
-            let gap = (pos[a] - pos[b]).norm() - radii[a] - radii[b];
-            if gap <= 0.0 {
-                let (sa, sb) = (a / 2, b / 2);
-                let cause = if sa == sb {
-                    format!("the two spheres of swimmer {sa} overlap (gap {gap:.3e} m)")
-                } else {
-                    format!(
-                        "sphere {} of swimmer {sa} overlaps sphere {} of swimmer {sb} (gap {gap:.3e} m)",
-                        a % 2 + 1,
-                        b % 2 + 1
-                    )
-                };
-                return Some(Problem {
-                    swimmer: Some(sa),
-                    cause,
-                    hint: "start the swimmers further apart, or use a smaller time step if the overlap came from a step that was too large".into(),
-                });
-            }
+        self.place(y);
+        match self.spheres.first_overlap() {
+            Some(p) => Err(p),
+            None => Ok(()),
         }
     }
-    None
 }

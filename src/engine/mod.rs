@@ -14,6 +14,7 @@ pub mod observable;
 pub mod recorder;
 pub mod rigid;
 pub mod scene;
+mod spheres;
 pub mod swimmer;
 
 pub use error::{EngineError, Result};

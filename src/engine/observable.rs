@@ -152,9 +152,11 @@ impl Observable {
                 vec![(before[0] - after[0]) / s.swimmer(i)?.ell]
             }
             Observable::Polarization => {
-                let n = s.count().max(1) as f64;
-                let sum: Vector3<f64> = (0..s.count()).map(|i| s.dir(i).unwrap()).sum();
-                vec![sum.norm() / n]
+                let mut sum = Vector3::zeros();
+                for i in 0..s.count() {
+                    sum += s.dir(i)?;
+                }
+                vec![sum.norm() / s.count().max(1) as f64]
             }
             Observable::Nematic => {
                 if s.count() == 0 {

@@ -11,9 +11,9 @@
 //! step is set by the stroke, not by the spring.
 
 use super::integrators::{OdeSystem, Problem};
-use super::micro::first_overlap;
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
+use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -22,12 +22,7 @@ use nalgebra::{DMatrix, DVector, Vector3};
 pub struct RigidSystem {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
-    mu: f64,
-    mobility: Mobility,
-    radii: Vec<f64>,
-    pos: Vec<Vector3<f64>>,
-    forces: Vec<Vector3<f64>>,
-    u: Vec<Vector3<f64>>,
+    spheres: Spheres,
     a: DMatrix<f64>,
     rate: DVector<f64>,
 }
@@ -35,17 +30,11 @@ pub struct RigidSystem {
 impl RigidSystem {
     /// A system for these swimmers, base positions, viscosity and mobility.
     pub fn new(swimmers: &[Dumbbell], base: &[Vector3<f64>], mu: f64, mobility: Mobility) -> Self {
-        let n = 2 * swimmers.len();
         let s = swimmers.len();
         RigidSystem {
             swimmers: swimmers.to_vec(),
             base: base.to_vec(),
-            mu,
-            mobility,
-            radii: swimmers.iter().flat_map(|d| [d.a1, d.a2]).collect(),
-            pos: vec![Vector3::zeros(); n],
-            forces: vec![Vector3::zeros(); n],
-            u: vec![Vector3::zeros(); n],
+            spheres: Spheres::new(swimmers, mu, mobility),
             a: DMatrix::zeros(s, s),
             rate: DVector::zeros(s),
         }
@@ -56,19 +45,20 @@ impl RigidSystem {
             let rh = self.base[s] + vec3(y, STATE_PER_SWIMMER * s);
             let n = vec3(y, STATE_PER_SWIMMER * s + 3);
             let (x1, x2) = d.sphere_positions(rh, n, d.rest_length(t));
-            self.pos[2 * s] = x1;
-            self.pos[2 * s + 1] = x2;
+            self.spheres.pos[2 * s] = x1;
+            self.spheres.pos[2 * s + 1] = x2;
         }
     }
 
     /// H_αβ v for spheres α, β (self term when α = β).
     fn h(&self, alpha: usize, beta: usize, v: &Vector3<f64>) -> Vector3<f64> {
+        let sp = &self.spheres;
         if alpha == beta {
-            v * self_mobility(self.mu, self.radii[alpha])
+            v * self_mobility(sp.mu, sp.radii[alpha])
         } else {
-            let r = self.pos[alpha] - self.pos[beta];
-            self.mobility
-                .pair_apply(self.mu, &r, self.radii[alpha], self.radii[beta], v)
+            let r = sp.pos[alpha] - sp.pos[beta];
+            sp.mobility
+                .pair_apply(sp.mu, &r, sp.radii[alpha], sp.radii[beta], v)
         }
     }
 
@@ -110,23 +100,13 @@ impl OdeSystem for RigidSystem {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
         self.place(t, y);
         self.solve(t, y);
-        for s in 0..self.swimmers.len() {
-            let f = self.rate[s] * vec3(y, STATE_PER_SWIMMER * s + 3);
-            self.forces[2 * s] = f;
-            self.forces[2 * s + 1] = -f;
-        }
-        self.mobility.interaction_velocities(
-            self.mu,
-            &self.pos,
-            &self.radii,
-            &self.forces,
-            &mut self.u,
-        );
+        let tension = &self.rate;
+        self.spheres
+            .interact(|s| tension[s] * vec3(y, STATE_PER_SWIMMER * s + 3));
         for (s, d) in self.swimmers.iter().enumerate() {
-            let (u1, u2) = (self.u[2 * s], self.u[2 * s + 1]);
             let n = vec3(y, STATE_PER_SWIMMER * s + 3);
-            let drh = d.w1() * u1 + d.w2() * u2;
-            let rel = u2 - u1;
+            let drh = self.spheres.center_rate(s, d);
+            let rel = self.spheres.relative_rate(s);
             let dn = (rel - n * n.dot(&rel)) / d.rest_length(t);
             set_vec3(dy, STATE_PER_SWIMMER * s, &drh);
             set_vec3(dy, STATE_PER_SWIMMER * s + 3, &dn);
@@ -145,7 +125,7 @@ impl OdeSystem for RigidSystem {
 
     fn check(&mut self, t: f64, y: &[f64]) -> Result<(), Problem> {
         self.place(t, y);
-        match first_overlap(&self.pos, &self.radii) {
+        match self.spheres.first_overlap() {
             Some(p) => Err(p),
             None => Ok(()),
         }

@@ -49,9 +49,9 @@ const COMMANDS: &[(&str, &str)] = &[
 impl Session {
     /// A fresh session.
     pub fn new() -> Self {
-        let engine = script::engine();
+        let (engine, embedded) = script::engine_and_stdlib();
         Session {
-            resolver: script::stdlib::resolver(&engine),
+            resolver: script::stdlib::resolver(embedded),
             engine,
             scope: Scope::new(),
             functions: AST::empty(),

@@ -8,6 +8,12 @@ use rhai::{Engine, Scope};
 
 /// A Rhai engine with the whole swimlab vocabulary registered.
 pub fn engine() -> Engine {
+    engine_and_stdlib().0
+}
+
+/// The engine of [`engine()`] and the stdlib modules it compiled, for a caller that resolves
+/// imports itself (the REPL keeps imports across inputs) without compiling them again.
+pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResolver) {
     let mut engine = Engine::new();
     engine.set_max_expr_depths(256, 256);
     dumbbell_api::register(&mut engine);
@@ -17,10 +23,10 @@ pub fn engine() -> Engine {
     float_cmp::register(&mut engine);
     csv_api::register(&mut engine);
     util_api::register(&mut engine);
-    stdlib::install(&mut engine);
+    let embedded = stdlib::install(&mut engine);
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
-    engine
+    (engine, embedded)
 }
 
 /// Run script text; on error return the rendered message (file, line, column, caret).

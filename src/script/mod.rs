@@ -24,7 +24,7 @@ pub fn suggest_name(word: &str) -> Option<&'static str> {
     convert::suggest(word, &names)
 }
 pub use dumbbell_api::DumbbellSpec;
-pub use engine_builder::{engine, run_file, run_source};
+pub use engine_builder::{engine, engine_and_stdlib, run_file, run_source};
 pub use observable_api::RecorderHandle;
 pub use render::render_error;
 pub use scene_api::SceneHandle;

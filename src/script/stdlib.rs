@@ -11,14 +11,24 @@ pub const MODULES: &[(&str, &str)] = &[
     ("measure", include_str!("../../stdlib/measure.rhai")),
 ];
 
-/// Install the resolver: the embedded modules first, then files.
-pub fn install(engine: &mut Engine) {
-    let resolver = resolver(engine);
-    engine.set_module_resolver(resolver);
+/// Compile the embedded modules with `engine`, install the resolver (embedded modules first, then
+/// files), and return the compiled modules for whoever else resolves imports (the REPL session).
+pub fn install(engine: &mut Engine) -> StaticModuleResolver {
+    let embedded = compile(engine);
+    engine.set_module_resolver(resolver(embedded.clone()));
+    embedded
 }
 
-/// The resolver `install` sets: embedded modules (compiled with `engine`) first, then files.
-pub fn resolver(engine: &Engine) -> ModuleResolversCollection {
+/// Embedded modules first, then files relative to the working folder.
+pub fn resolver(embedded: StaticModuleResolver) -> ModuleResolversCollection {
+    let mut all = ModuleResolversCollection::new();
+    all.push(embedded);
+    all.push(FileModuleResolver::new());
+    all
+}
+
+/// The embedded modules, compiled with `engine` (cheap to clone: modules are shared).
+fn compile(engine: &Engine) -> StaticModuleResolver {
     let mut embedded = StaticModuleResolver::new();
     for (name, source) in MODULES {
         // The modules are ours and compiled in tests; a broken one is reported, never a panic.
@@ -32,8 +42,5 @@ pub fn resolver(engine: &Engine) -> ModuleResolversCollection {
             Err(e) => eprintln!("warning: stdlib module \"{name}\" failed to load: {e}"),
         }
     }
-    let mut all = ModuleResolversCollection::new();
-    all.push(embedded);
-    all.push(FileModuleResolver::new());
-    all
+    embedded
 }

@@ -1,7 +1,7 @@
 //! Dormand-Prince 5(4) with embedded error estimate, FSAL, and Hairer's PI step-size controller
 //! (Hairer, Nørsett & Wanner, *Solving ODEs I*, II.4 and the `DOPRI5` code).
 
-use super::system::{check_state, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
+use super::system::{check_state, fit, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
 
 const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
 const A: [[f64; 6]; 7] = [
@@ -157,12 +157,22 @@ impl Stepper for Dopri5 {
         stats: &mut Stats,
     ) -> Result<f64, StepFailure> {
         let n = y.len();
-        for k in &mut self.k {
-            k.resize(n, 0.0);
-        }
-        self.tmp.resize(n, 0.0);
-        self.y_new.resize(n, 0.0);
-        self.scale.resize(n, 0.0);
+        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
+        fit(
+            n,
+            &mut [
+                k1,
+                k2,
+                k3,
+                k4,
+                k5,
+                k6,
+                k7,
+                &mut self.tmp,
+                &mut self.y_new,
+                &mut self.scale,
+            ],
+        );
         sys.error_scale(y, &mut self.scale);
         if !self.fsal_valid {
             sys.rhs(t, y, &mut self.k[0]);

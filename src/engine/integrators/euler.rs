@@ -1,6 +1,6 @@
 //! Explicit (forward) Euler, first order.
 
-use super::system::{check_state, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
+use super::system::{check_state, fit, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
 
 /// Forward Euler with steps of at most `dt`.
 #[derive(Debug, Clone)]
@@ -31,8 +31,7 @@ impl Stepper for Euler {
         stats: &mut Stats,
     ) -> Result<f64, StepFailure> {
         let n = y.len();
-        self.k.resize(n, 0.0);
-        self.y_new.resize(n, 0.0);
+        fit(n, &mut [&mut self.k, &mut self.y_new]);
         let (h, last) = uniform_step(t, t_end, self.dt);
         sys.rhs(t, y, &mut self.k);
         stats.rhs_evals += 1;

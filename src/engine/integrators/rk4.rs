@@ -1,6 +1,6 @@
 //! The classic fourth-order Runge-Kutta method.
 
-use super::system::{check_state, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
+use super::system::{check_state, fit, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
 
 /// Classic RK4 with steps of at most `dt`.
 #[derive(Debug, Clone)]
@@ -31,10 +31,8 @@ impl Stepper for Rk4 {
         stats: &mut Stats,
     ) -> Result<f64, StepFailure> {
         let n = y.len();
-        for k in &mut self.k {
-            k.resize(n, 0.0);
-        }
-        self.tmp.resize(n, 0.0);
+        let [k1, k2, k3, k4] = &mut self.k;
+        fit(n, &mut [k1, k2, k3, k4, &mut self.tmp]);
         let (h, last) = uniform_step(t, t_end, self.dt);
         let [k1, k2, k3, k4] = &mut self.k;
         let tmp = &mut self.tmp;

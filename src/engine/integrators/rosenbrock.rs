@@ -11,7 +11,7 @@
 //! Stage equations (Hairer & Wanner, IV.7, with k including the factor h):
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
 
-use super::system::{check_state, tolerance_failure, Problem, StepFailure};
+use super::system::{check_state, fit, tolerance_failure, Problem, StepFailure};
 use super::{OdeSystem, Stats, Stepper};
 use nalgebra::{DMatrix, DVector};
 
@@ -65,6 +65,8 @@ pub struct Rosenbrock {
     jac: Vec<f64>,
     /// LU factors of W = I − hγJ per block, for the step size being tried.
     lus: Vec<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// One block's right-hand side, solved in place (no allocation per stage).
+    block: DVector<f64>,
 }
 
 impl Rosenbrock {
@@ -84,6 +86,7 @@ impl Rosenbrock {
             scale: Vec::new(),
             jac: Vec::new(),
             lus: Vec::new(),
+            block: DVector::zeros(0),
         }
     }
 
@@ -131,18 +134,17 @@ impl Rosenbrock {
             for blk in 0..(n.checked_div(bs).unwrap_or(0)) {
                 let o = blk * bs;
                 let jb = &self.jac[blk * bs * bs..(blk + 1) * bs * bs];
-                let mut rhs = DVector::zeros(bs);
                 for r in 0..bs {
                     let mut jv = 0.0;
                     for q in 0..bs {
                         jv += jb[r * bs + q] * self.acc[o + q];
                     }
-                    rhs[r] = h * self.f[o + r] + h * jv + h * h * gh * self.ft[o + r];
+                    self.block[r] = h * self.f[o + r] + h * jv + h * h * gh * self.ft[o + r];
                 }
-                let sol = self.lus[blk]
-                    .solve(&rhs)
-                    .unwrap_or_else(|| DVector::from_element(bs, f64::NAN));
-                self.k[i][o..o + bs].copy_from_slice(sol.as_slice());
+                if !self.lus[blk].solve_mut(&mut self.block) {
+                    self.block.fill(f64::NAN);
+                }
+                self.k[i][o..o + bs].copy_from_slice(self.block.as_slice());
             }
             if bs == 0 {
                 for m in 0..n {
@@ -176,18 +178,27 @@ impl Stepper for Rosenbrock {
         stats: &mut Stats,
     ) -> Result<f64, StepFailure> {
         let n = y.len();
-        for v in self.k.iter_mut().chain([
-            &mut self.f,
-            &mut self.f0,
-            &mut self.ft,
-            &mut self.tmp,
-            &mut self.acc,
-            &mut self.y_new,
-            &mut self.scale,
-        ]) {
-            v.resize(n, 0.0);
-        }
+        let [k1, k2, k3, k4] = &mut self.k;
+        fit(
+            n,
+            &mut [
+                k1,
+                k2,
+                k3,
+                k4,
+                &mut self.f,
+                &mut self.f0,
+                &mut self.ft,
+                &mut self.tmp,
+                &mut self.acc,
+                &mut self.y_new,
+                &mut self.scale,
+            ],
+        );
         let bs = sys.jacobian_block();
+        if self.block.len() != bs {
+            self.block = DVector::zeros(bs);
+        }
         if bs > 0 && n % bs != 0 {
             return Err(StepFailure {
                 time: t,

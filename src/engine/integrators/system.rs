@@ -78,6 +78,13 @@ pub trait Stepper {
     fn reset(&mut self) {}
 }
 
+/// Size every scratch buffer of a stepper to the state's length (allocates only when it grows).
+pub(crate) fn fit(n: usize, buffers: &mut [&mut Vec<f64>]) {
+    for b in buffers {
+        b.resize(n, 0.0);
+    }
+}
+
 /// Step size of a fixed-step method: the largest h ≤ dt that divides the remaining span evenly, so
 /// a run ends exactly at `t_end`. Returns (h, is_last).
 pub(crate) fn uniform_step(t: f64, t_end: f64, dt: f64) -> (f64, bool) {
