@@ -58,10 +58,13 @@ enum BenchKind {
     WorkPrecision,
     /// Largest stable step of each explicit method against 2/rate and 2.785/rate.
     Stability,
+    /// CPU against GPU: time per RK4 step against size (8 … 16,384 spheres or swimmers; --quick:
+    /// up to 1,024), transfers included, both models; the crossover and the "auto" calibration.
+    Backends,
 }
 
 fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
-    use swimlab::bench::{stability, work_precision};
+    use swimlab::bench::{backends, stability, work_precision};
     use swimlab::engine::Model;
     let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
     match which {
@@ -98,6 +101,30 @@ fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
             t.write_csv(std::path::Path::new("out/bench/stability.csv"))
                 .map_err(io)?;
             println!("\nCSV written to out/bench/stability.csv");
+        }
+        BenchKind::Backends => {
+            match swimlab::engine::gpu::device() {
+                Ok(d) => println!("GPU adapter: {}", d.describe()),
+                Err(e) => println!("GPU: {e}"),
+            }
+            let rows = backends::run(if quick { 1024 } else { 16384 });
+            let t = backends::table(&rows);
+            println!("wall time per RK4 step (one process, medians not taken; '-' = over the time budget or no adapter):\n{}", t.render());
+            for m in [Model::Micro, Model::Averaged] {
+                match backends::measured_crossover(&rows, m) {
+                    Some(n) => println!("{}: the GPU is faster from {n} in this table", m.name()),
+                    None => println!(
+                        "{}: the GPU is not faster at any size in this table",
+                        m.name()
+                    ),
+                }
+            }
+            for (m, detail) in backends::auto_thresholds() {
+                println!("auto calibration, {}: {detail}", m.name());
+            }
+            t.write_csv(std::path::Path::new("out/bench/backends.csv"))
+                .map_err(io)?;
+            println!("\nCSV written to out/bench/backends.csv");
         }
     }
     Ok(())

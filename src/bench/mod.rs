@@ -1,6 +1,7 @@
-//! Benchmarks run by `swimlab bench ...`: work against precision, and stability limits. They use
+//! Benchmarks run by `swimlab bench ...`: work against precision, stability limits, and CPU against GPU. They use
 //! the engine only and measure on the machine at hand; figures are reported, never asserted.
 
+pub mod backends;
 pub mod stability;
 pub mod table;
 pub mod work_precision;

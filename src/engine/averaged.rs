@@ -94,6 +94,12 @@ impl Coef {
     }
 }
 
+/// A swimmer's constants as the GPU kernel reads them: A_R, c_J, A_N, v0, w0, Λ/ℓ, ℓ, φ.
+pub(crate) fn pair_constants(d: &Dumbbell, set: Coefficients) -> [f64; 8] {
+    let c = Coef::new(d, set);
+    [c.a_r, c.c_j, c.a_n, c.v0, c.w0, c.big_l, c.ell, c.phase]
+}
+
 /// The stroke-averaged right-hand side.
 #[derive(Debug, Clone)]
 pub struct AveragedSystem {

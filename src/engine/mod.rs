@@ -5,7 +5,10 @@
 //! [`IntegratorSpec`]. All quantities are SI.
 
 pub mod averaged;
+pub mod backend;
+pub mod build;
 pub mod error;
+pub mod gpu;
 pub mod integrators;
 pub mod micro;
 pub mod mobility;
@@ -17,6 +20,7 @@ pub mod scene;
 mod spheres;
 pub mod swimmer;
 
+pub use backend::Backend;
 pub use error::{EngineError, Result};
 pub use integrators::IntegratorSpec;
 pub use mobility::Mobility;

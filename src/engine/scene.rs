@@ -2,8 +2,10 @@
 //! engine's single entry point for the script layer.
 
 use super::averaged::AveragedSystem;
+use super::backend::{self, Backend};
 use super::error::{invalid, require_finite, require_positive, EngineError, Result};
-use super::integrators::{IntegratorSpec, OdeSystem, Stats, Stepper};
+use super::gpu::{GpuModel, GpuRun, RunOutcome, UniformSteps};
+use super::integrators::{uniform_steps, IntegratorSpec, OdeSystem, Stats, Stepper};
 use super::micro::MicroSystem;
 use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
@@ -57,6 +59,12 @@ pub struct Scene {
     state: Vec<f64>,
     time: f64,
     stats: Stats,
+    /// Where the dynamics run (saved; "cpu" for files from before backends existed).
+    #[serde(default)]
+    backend: Backend,
+    /// Device buffers of the last GPU run, reused while the scene's size and method stay.
+    #[serde(skip)]
+    gpu: Option<GpuRun>,
     /// The stepper of the last run, kept so an adaptive one remembers its step size.
     #[serde(skip)]
     stepper: Option<(IntegratorSpec, Box<dyn Stepper>)>,
@@ -78,6 +86,8 @@ impl Default for Scene {
             state: Vec::new(),
             time: 0.0,
             stats: Stats::default(),
+            backend: Backend::default(),
+            gpu: None,
             stepper: None,
             recorders: Vec::new(),
         }
@@ -98,6 +108,8 @@ impl Clone for Scene {
             state: self.state.clone(),
             time: self.time,
             stats: self.stats,
+            backend: self.backend,
+            gpu: None,
             stepper: None,
             recorders: Vec::new(),
         }
@@ -130,6 +142,26 @@ impl Scene {
     /// length), at length L(t) of the current time. Returns its 0-based index.
     pub fn add(&mut self, d: Dumbbell, center: Vector3<f64>, dir: Vector3<f64>) -> Result<usize> {
         d.validate()?;
+        self.check_room(&d, center, dir)?;
+        let n = unit_direction(dir)?;
+        let len = d.rest_length(self.time);
+        self.swimmers.push(d);
+        self.base.push(center);
+        let v = match self.model {
+            Model::Micro => n * len,
+            Model::Averaged | Model::Rigid => n,
+        };
+        self.state
+            .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
+        Ok(self.swimmers.len() - 1)
+    }
+
+    /// Whether [`Scene::add`] would accept this swimmer (valid, and no sphere overlaps another).
+    pub fn fits(&self, d: &Dumbbell, center: Vector3<f64>, dir: Vector3<f64>) -> bool {
+        d.validate().is_ok() && self.check_room(d, center, dir).is_ok()
+    }
+
+    fn check_room(&self, d: &Dumbbell, center: Vector3<f64>, dir: Vector3<f64>) -> Result<()> {
         for (k, c) in ["x", "y", "z"].iter().zip(center.iter()) {
             require_finite(&format!("center.{k}"), *c)?;
         }
@@ -149,15 +181,7 @@ impl Scene {
                 }
             }
         }
-        self.swimmers.push(d);
-        self.base.push(center);
-        let v = match self.model {
-            Model::Micro => n * len,
-            Model::Averaged | Model::Rigid => n,
-        };
-        self.state
-            .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
-        Ok(self.swimmers.len() - 1)
+        Ok(())
     }
 
     /// Viscosity μ (Pa s).
@@ -227,25 +251,88 @@ impl Scene {
     /// whose steps grow to a good fraction of a period (the averaged model is not stiff).
     pub fn default_integrator(&self) -> IntegratorSpec {
         match self.model {
-            Model::Micro => {
-                let t_min = self
-                    .swimmers
-                    .iter()
-                    .map(Dumbbell::period)
-                    .fold(f64::INFINITY, f64::min);
-                let rate = self.stiff_rate();
-                let dt = (DEFAULT_MICRO_STEP_TIMES_RATE / rate)
-                    .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min);
-                IntegratorSpec::Rk4 {
-                    dt: if dt.is_finite() { dt } else { 1e-6 },
-                }
-            }
+            Model::Micro => IntegratorSpec::Rk4 {
+                dt: self.default_micro_step(),
+            },
             Model::Averaged => IntegratorSpec::Dopri5 {
                 rtol: DEFAULT_AVERAGED_RTOL,
             },
             Model::Rigid => IntegratorSpec::Dopri5 {
                 rtol: DEFAULT_RIGID_RTOL,
             },
+        }
+    }
+
+    /// The microscopic model's default RK4 step for these swimmers (s): 0.8/rate of the stiffest
+    /// spring, at most 1/200 of the shortest period.
+    pub fn default_micro_step(&self) -> f64 {
+        let t_min = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(f64::INFINITY, f64::min);
+        let dt = (DEFAULT_MICRO_STEP_TIMES_RATE / self.stiff_rate())
+            .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min);
+        if dt.is_finite() {
+            dt
+        } else {
+            1e-6
+        }
+    }
+
+    /// Where the dynamics run.
+    pub fn backend(&self) -> Backend {
+        self.backend
+    }
+
+    /// Choose where the dynamics run (checked when the scene runs: see [`Scene::backend_info`]).
+    pub fn set_backend(&mut self, b: Backend) {
+        self.backend = b;
+    }
+
+    /// Which backend the next run uses and why, e.g. "cpu: 4 spheres, below the GPU crossover
+    /// ...". For "gpu" on a scene that cannot run there, the error says why.
+    pub fn backend_info(&self) -> Result<String> {
+        self.plan()
+            .map(|(gpu, why)| format!("{}: {why}", if gpu { "gpu" } else { "cpu" }))
+    }
+
+    /// Whether the next run takes the GPU, and why.
+    fn plan(&self) -> Result<(bool, String)> {
+        let fit = backend::gpu_model_supported(self.model)
+            .and_then(|()| backend::gpu_tableau(&self.integrator()).map(|_| ()));
+        match self.backend {
+            Backend::Cpu => Ok((false, "s.backend = \"cpu\"".into())),
+            Backend::Gpu => {
+                fit.map_err(|e| invalid!("s.backend = \"gpu\": {e}; set s.backend = \"cpu\" or \"auto\", or s.integrator = rk4(dt)"))?;
+                let dev = super::gpu::device().map_err(|e| invalid!("s.backend = \"gpu\": {e}"))?;
+                Ok((true, format!("{} (s.backend = \"gpu\")", dev.describe())))
+            }
+            Backend::Auto => {
+                if let Err(e) = fit {
+                    return Ok((false, format!("auto: {e}")));
+                }
+                let dev = match super::gpu::device() {
+                    Ok(d) => d,
+                    Err(e) => return Ok((false, format!("auto: {e}"))),
+                };
+                let (size, unit) = match self.model {
+                    Model::Averaged => (self.count(), "swimmers"),
+                    _ => (2 * self.count(), "spheres"),
+                };
+                let c = backend::crossover(self.model);
+                Ok(match c.size {
+                    Some(n) if size >= n => (
+                        true,
+                        format!("auto: {} with {size} {unit}, at or above the measured crossover of {n} ({})", dev.describe(), c.detail),
+                    ),
+                    Some(n) => (
+                        false,
+                        format!("auto: {size} {unit}, below the measured GPU crossover of {n} ({})", c.detail),
+                    ),
+                    None => (false, format!("auto: {}", c.detail)),
+                })
+            }
         }
     }
 
@@ -567,11 +654,97 @@ impl Scene {
         result
     }
 
-    /// Integrate to `t_end` with the guards (the loop of [`Scene::run`] without recorders).
+    /// Integrate to `t_end` with the guards (the loop of [`Scene::run`] without recorders), on the
+    /// backend [`Scene::backend_info`] names.
     fn advance_to(&mut self, t_end: f64, interrupted: &dyn Fn() -> bool) -> Result<()> {
         if self.time >= t_end {
             return Ok(());
         }
+        if self.plan()?.0 {
+            self.advance_gpu(t_end, interrupted)
+        } else {
+            self.advance_cpu(t_end, interrupted, u64::MAX)
+        }
+    }
+
+    /// [`Scene::advance_to`] on the GPU: uniform steps as the CPU stepper takes them. A step whose
+    /// state fails a guard on the device is replayed on the CPU, which either reports it exactly
+    /// as the CPU backend does or (a borderline case decided differently by rounding) takes it.
+    fn advance_gpu(&mut self, t_end: f64, interrupted: &dyn Fn() -> bool) -> Result<()> {
+        let (dt, tableau) =
+            backend::gpu_tableau(&self.integrator()).map_err(|e| invalid!("{e}"))?;
+        let model = match self.model {
+            Model::Micro => GpuModel::Micro {
+                mu: self.mu,
+                mobility: self.mobility,
+            },
+            Model::Averaged => {
+                self.check_averaged()?;
+                GpuModel::Averaged {
+                    coefficients: self.coefficients,
+                }
+            }
+            Model::Rigid => return Err(invalid!("the rigid-stroke model runs on the CPU only")),
+        };
+        let mut run = match self.gpu.take() {
+            Some(r) if r.fits(model, self.count(), &tableau) => r,
+            _ => GpuRun::new(model, self.count(), tableau.clone()).map_err(|e| invalid!("{e}"))?,
+        };
+        let stages = tableau.stages() as u64;
+        let result = loop {
+            if self.time >= t_end {
+                break Ok(());
+            }
+            let (n, h) = uniform_steps(self.time, t_end, dt);
+            let t0 = self.time;
+            let outcome = run.run(
+                &self.swimmers,
+                &self.base,
+                &mut self.state,
+                UniformSteps { t0, h, count: n },
+                interrupted,
+            );
+            let done = match outcome {
+                Err(e) => {
+                    break Err(invalid!(
+                        "the GPU run failed: {e}; the scene keeps its state at t = {:.6e} s; use s.backend = \"cpu\"",
+                        self.time
+                    ))
+                }
+                Ok(RunOutcome::Done) => n,
+                Ok(RunOutcome::Failed { steps_done }) | Ok(RunOutcome::Interrupted { steps_done }) => steps_done,
+            };
+            self.time = if done == n {
+                t_end
+            } else {
+                t0 + done as f64 * h
+            };
+            self.stats.steps += done;
+            self.stats.rhs_evals += done * stages + 1;
+            match outcome {
+                Ok(RunOutcome::Interrupted { .. }) => {
+                    break Err(EngineError::Interrupted { time: self.time })
+                }
+                Ok(RunOutcome::Failed { .. }) => {
+                    // One step on the CPU: the same step, checked by the same guards.
+                    if let Err(e) = self.advance_cpu(t_end, interrupted, 1) {
+                        break Err(e);
+                    }
+                }
+                _ => {}
+            }
+        };
+        self.gpu = Some(run);
+        result
+    }
+
+    /// [`Scene::advance_to`] on the CPU, taking at most `max_steps` steps.
+    fn advance_cpu(
+        &mut self,
+        t_end: f64,
+        interrupted: &dyn Fn() -> bool,
+        max_steps: u64,
+    ) -> Result<()> {
         let mut sys = self.system()?;
         let spec = self.integrator();
         let mut stepper = match self.stepper.take() {
@@ -582,7 +755,9 @@ impl Scene {
             _ => spec.build(),
         };
         let mut outcome = Ok(());
-        while self.time < t_end {
+        let mut taken = 0;
+        while self.time < t_end && taken < max_steps {
+            taken += 1;
             if interrupted() {
                 outcome = Err(EngineError::Interrupted { time: self.time });
                 break;
@@ -641,6 +816,23 @@ impl Scene {
             .map(|d| d.relaxation_rate(self.mu))
             .fold(0.0, f64::max)
     }
+}
+
+/// A cubic lattice of `swimmers` Fig-1 swimmers (symmetric, spacing 3ℓ, along x, phases spread
+/// over the period) for timings: every pair interacts.
+pub fn lattice_scene(swimmers: usize, model: Model) -> Result<Scene> {
+    let mut s = Scene::new();
+    s.set_model(model);
+    let d = Dumbbell::default();
+    let side = (swimmers as f64).cbrt().ceil() as usize;
+    let spacing = 3.0 * d.ell;
+    for i in 0..swimmers {
+        let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
+        let phase = (i as f64 * 0.7) % (2.0 * std::f64::consts::PI);
+        let c = Vector3::new(x as f64, y as f64, z as f64) * spacing;
+        s.add(Dumbbell { phase, ..d }, c, Vector3::x())?;
+    }
+    Ok(s)
 }
 
 /// A run that is never interrupted.

@@ -6,7 +6,7 @@
 use super::convert::{array3, index, lift, number, script_error, unknown_choice, ScriptResult};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
-use crate::engine::{Coefficients, IntegratorSpec, Mobility, Model, Scene};
+use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene};
 use rhai::{Array, Dynamic, Engine, ImmutableString, INT};
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -51,12 +51,16 @@ fn swimmer_index(v: &Dynamic) -> ScriptResult<usize> {
 
 /// One-line description of a scene (what `print(s)` shows).
 pub fn summary(s: &Scene) -> String {
+    let backend = match s.backend() {
+        Backend::Cpu => String::new(),
+        b => format!(", backend = \"{}\"", b.name()),
+    };
     let period = s
         .period()
         .map(|t| format!(", T = {t:.6e} s"))
         .unwrap_or_default();
     format!(
-        "Scene({} swimmers, model = \"{}\", mobility = \"{}\", integrator = {}{}, mu = {:e} Pa s, t = {:.6e} s{period})",
+        "Scene({} swimmers, model = \"{}\", mobility = \"{}\", integrator = {}{}, mu = {:e} Pa s, t = {:.6e} s{period}{backend})",
         s.count(),
         s.model().name(),
         s.mobility().name(),
@@ -129,6 +133,25 @@ pub fn register(engine: &mut Engine) {
                 Ok(())
             },
         )
+        .register_get("backend", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().backend().name()))
+        .register_set(
+            "backend",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let name = string_arg("backend", &v)?;
+                let b = Backend::parse(&name)
+                    .map_err(|_| unknown_choice("backend", &name, &["cpu", "gpu", "auto"]))?;
+                if b == Backend::Gpu {
+                    crate::engine::gpu::device().map_err(|e| {
+                        script_error(format!("s.backend = \"gpu\": {e}"))
+                    })?;
+                }
+                s.0.borrow_mut().set_backend(b);
+                Ok(())
+            },
+        )
+        .register_get("backend_info", |s: &mut SceneHandle| {
+            s.with(|sc| sc.backend_info()).map(ImmutableString::from)
+        })
         .register_get("coefficients", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().coefficients().name()))
         .register_set(
             "coefficients",

@@ -17,4 +17,4 @@ pub use euler::Euler;
 pub use rk4::Rk4;
 pub use rosenbrock::Rosenbrock;
 pub use spec::IntegratorSpec;
-pub use system::{OdeSystem, Problem, Stats, StepFailure, Stepper};
+pub use system::{uniform_steps, OdeSystem, Problem, Stats, StepFailure, Stepper};

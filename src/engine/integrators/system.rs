@@ -88,10 +88,17 @@ pub(crate) fn fit(n: usize, buffers: &mut [&mut Vec<f64>]) {
 /// Step size of a fixed-step method: the largest h ≤ dt that divides the remaining span evenly, so
 /// a run ends exactly at `t_end`. Returns (h, is_last).
 pub(crate) fn uniform_step(t: f64, t_end: f64, dt: f64) -> (f64, bool) {
+    let (n, h) = uniform_steps(t, t_end, dt);
+    (h, n <= 1)
+}
+
+/// The number of steps of at most `dt` that a fixed-step method takes from `t` to `t_end`, and
+/// their size (the first step of [`uniform_step`]'s sequence).
+pub fn uniform_steps(t: f64, t_end: f64, dt: f64) -> (u64, f64) {
     let span = t_end - t;
     // The 1e-9 slack keeps span = k·dt from turning into k+1 steps through rounding.
     let n = (span / dt - 1e-9).ceil().max(1.0);
-    (span / n, n <= 1.0)
+    (n as u64, span / n)
 }
 
 /// Finite-value guard shared by all steppers, applied before the model's own check.

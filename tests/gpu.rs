@@ -1,0 +1,290 @@
+//! The GPU backend against the CPU: one step to round-off, the Fig-1 drift over 10 periods, a
+//! 1,000-swimmer suspension, guard failures, and the fallback without an adapter.
+//!
+//! Without an f64-capable adapter these tests skip with a message, unless SWIMLAB_REQUIRE_GPU=1
+//! (set by .ci/run, which installs lavapipe), where a missing adapter fails them.
+
+mod common;
+
+use common::{aligned_pair, mirror_inwards, ELL};
+use nalgebra::Vector3;
+use swimlab::engine::build::{random_suspension, Orientations, Phases};
+use swimlab::engine::scene::never;
+use swimlab::engine::{Backend, Dumbbell, IntegratorSpec, Model, Scene};
+
+fn gpu_present(test: &str) -> bool {
+    match swimlab::engine::gpu::device() {
+        Ok(_) => true,
+        Err(e) => {
+            if std::env::var_os("SWIMLAB_REQUIRE_GPU").is_some_and(|v| v != "0") {
+                panic!("{test}: SWIMLAB_REQUIRE_GPU is set but {e}");
+            }
+            eprintln!("{test}: skipped, {e}");
+            false
+        }
+    }
+}
+
+/// A CPU and a GPU copy of the scene.
+fn twins(s: &Scene) -> (Scene, Scene) {
+    let mut g = s.clone();
+    g.set_backend(Backend::Gpu);
+    let mut c = s.clone();
+    c.set_backend(Backend::Cpu);
+    (c, g)
+}
+
+/// max |Δ_gpu − Δ_cpu| / max |Δ_cpu| over the components of each block (0: centres, 1: b or N),
+/// where Δ is the change of the state over the run.
+fn block_mismatch(y0: &[f64], cpu: &[f64], gpu: &[f64]) -> [f64; 2] {
+    let mut out = [0.0; 2];
+    for (block, o) in out.iter_mut().enumerate() {
+        let (mut diff, mut size) = (0.0f64, 0.0f64);
+        for i in (0..y0.len()).filter(|i| (i % 6) / 3 == block) {
+            diff = diff.max(((gpu[i] - y0[i]) - (cpu[i] - y0[i])).abs());
+            size = size.max((cpu[i] - y0[i]).abs());
+        }
+        *o = diff / size;
+    }
+    out
+}
+
+fn one_step_mismatch(s: &Scene, dt: f64) -> [f64; 2] {
+    let (mut c, mut g) = twins(s);
+    for x in [&mut c, &mut g] {
+        x.set_integrator(Some(IntegratorSpec::rk4(dt).unwrap()));
+        x.run(dt, &never).unwrap();
+    }
+    assert_eq!(c.time(), g.time());
+    block_mismatch(s.raw_state().0, c.raw_state().0, g.raw_state().0)
+}
+
+// One RK4 step: both backends evaluate the same formulas in f64 in a different order (pair sums,
+// stage combinations) and with a different sin (a polynomial on the device); the differences are
+// a few ulps of each term, ~1e-15 of the step's change. 1e-12 is the bound.
+#[test]
+fn one_step_agrees_to_round_off_micro() {
+    if !gpu_present("one_step_agrees_to_round_off_micro") {
+        return;
+    }
+    for s in [
+        mirror_inwards(10.0, true),
+        aligned_pair(4.0, false, 1.0, 1.0),
+    ] {
+        let dt = s.default_micro_step();
+        let m = one_step_mismatch(&s, dt);
+        assert!(
+            m[0] <= 1e-12 && m[1] <= 1e-12,
+            "micro one-step mismatch {m:?}"
+        );
+    }
+}
+
+#[test]
+fn one_step_agrees_to_round_off_averaged() {
+    if !gpu_present("one_step_agrees_to_round_off_averaged") {
+        return;
+    }
+    let mut s = Scene::new();
+    s.set_model(Model::Averaged);
+    let d = common::swimmer(0.15, true, 0.0);
+    s.add(d, Vector3::zeros(), Vector3::new(1.0, 0.2, 0.1))
+        .unwrap();
+    s.add(
+        Dumbbell { phase: 1.0, ..d },
+        Vector3::new(6.0, 2.0, -1.0) * ELL,
+        Vector3::new(-0.3, 1.0, 0.5),
+    )
+    .unwrap();
+    s.add(
+        Dumbbell { phase: 2.5, ..d },
+        Vector3::new(-3.0, 5.0, 2.0) * ELL,
+        Vector3::new(0.0, 0.0, 1.0),
+    )
+    .unwrap();
+    let m = one_step_mismatch(&s, 100.0 * d.period());
+    assert!(
+        m[0] <= 1e-12 && m[1] <= 1e-12,
+        "averaged one-step mismatch {m:?}"
+    );
+}
+
+// Fig-1 pair, default RK4 step, 10 periods after one settling period: the drift (~1e-6 ℓ per
+// period) is the difference of two positions ~10ℓ apart, so round-off differences of 1e-16 in
+// the positions appear at ~1e-10 of the drift; 1e-9 is the bound.
+#[test]
+fn fig1_drift_over_ten_periods_agrees() {
+    if !gpu_present("fig1_drift_over_ten_periods_agrees") {
+        return;
+    }
+    let (mut c, mut g) = twins(&mirror_inwards(10.0, true));
+    let (dc, _) = common::drift_per_period(&mut c, 10.0);
+    let (dg, _) = common::drift_per_period(&mut g, 10.0);
+    let rel = common::rel(dg, dc);
+    eprintln!("Fig-1 drift per period: cpu {dc:.12e} ell, gpu {dg:.12e} ell, relative difference {rel:.2e}");
+    assert!(rel <= 1e-9, "10-period drift differs by {rel:e}");
+}
+
+#[test]
+fn averaged_drift_over_many_periods_agrees() {
+    if !gpu_present("averaged_drift_over_many_periods_agrees") {
+        return;
+    }
+    let mut s = mirror_inwards(10.0, true);
+    s.set_model(Model::Averaged);
+    let t = s.period().unwrap();
+    s.set_integrator(Some(IntegratorSpec::rk4(t).unwrap()));
+    let (mut c, mut g) = twins(&s);
+    let (dc, sc) = common::drift_per_period(&mut c, 10.0);
+    let (dg, sg) = common::drift_per_period(&mut g, 10.0);
+    assert!(common::rel(dg, dc) <= 1e-9, "drift {dg:e} vs {dc:e}");
+    assert!(
+        (sg - sc).abs() <= 1e-9 * dc.abs(),
+        "separation {sg:e} vs {sc:e}"
+    );
+}
+
+/// 1,000 randomly placed and oriented swimmers with random phases at sphere volume fraction `phi`.
+fn suspension(model: Model, phi: f64) -> Scene {
+    let mut s = Scene::new();
+    s.set_model(model);
+    let d = common::swimmer(0.15, true, 0.0);
+    let side = swimlab::engine::build::box_side(1000, &d, phi).unwrap();
+    random_suspension(
+        &mut s,
+        1000,
+        d,
+        side,
+        Orientations::Random,
+        Phases::Random,
+        7,
+    )
+    .unwrap();
+    s
+}
+
+// A few steps of a dense random suspension: many more terms per sum than the pair, so the
+// round-off of the sums grows (~sqrt(terms) ulps); still far below 1e-12 of the change.
+#[test]
+fn random_suspension_of_1000_swimmers_agrees() {
+    if !gpu_present("random_suspension_of_1000_swimmers_agrees") {
+        return;
+    }
+    let s = suspension(Model::Micro, 0.01);
+    let dt = s.default_micro_step();
+    let (mut c, mut g) = twins(&s);
+    for x in [&mut c, &mut g] {
+        x.set_integrator(Some(IntegratorSpec::rk4(dt).unwrap()));
+        x.run(3.0 * dt, &never).unwrap();
+    }
+    let m = block_mismatch(s.raw_state().0, c.raw_state().0, g.raw_state().0);
+    eprintln!("1,000-swimmer micro, 3 steps: mismatch {m:?}");
+    assert!(m[0] <= 1e-12 && m[1] <= 1e-12, "{m:?}");
+
+    // The far-field averaged model at a lower density: its rates grow as D⁻⁵, and at the closest
+    // random distances of φ = 1% a period-long step would amplify round-off chaotically.
+    let s = suspension(Model::Averaged, 1e-3);
+    let (mut c, mut g) = twins(&s);
+    let h = s.period().unwrap();
+    for x in [&mut c, &mut g] {
+        x.set_integrator(Some(IntegratorSpec::rk4(h).unwrap()));
+        x.run(3.0 * h, &never).unwrap();
+    }
+    let m = block_mismatch(s.raw_state().0, c.raw_state().0, g.raw_state().0);
+    eprintln!("1,000-swimmer averaged, 3 steps: mismatch {m:?}");
+    assert!(m[0] <= 1e-12 && m[1] <= 1e-12, "{m:?}");
+}
+
+// A step far above the stability limit: the device's guard stops the run, the CPU replays the
+// step, and the error is the CPU backend's, word for word, with the last good state kept.
+#[test]
+fn unstable_step_fails_the_same_way_on_both_backends() {
+    if !gpu_present("unstable_step_fails_the_same_way_on_both_backends") {
+        return;
+    }
+    let s = mirror_inwards(10.0, true);
+    let dt = 6.0 / s.stiff_rate();
+    let (mut c, mut g) = twins(&s);
+    let mut errors = Vec::new();
+    for x in [&mut c, &mut g] {
+        x.set_integrator(Some(IntegratorSpec::euler(dt).unwrap()));
+        errors.push(x.run(200.0 * dt, &never).unwrap_err().to_string());
+    }
+    assert_eq!(errors[0], errors[1]);
+    assert_eq!(c.time(), g.time());
+    assert!(errors[1].contains("spring"), "{}", errors[1]);
+}
+
+#[test]
+fn recorders_see_the_same_rows() {
+    if !gpu_present("recorders_see_the_same_rows") {
+        return;
+    }
+    use swimlab::engine::{Observable, Recorder, Trigger};
+    let (mut c, mut g) = twins(&mirror_inwards(10.0, true));
+    let mut ids = Vec::new();
+    for x in [&mut c, &mut g] {
+        let t = x.period().unwrap();
+        let r = Recorder::new(
+            x,
+            vec![Observable::CenterH(0)],
+            Trigger::EverySeconds(t / 4.0),
+        )
+        .unwrap();
+        ids.push(x.add_recorder(r));
+        x.run(2.0 * t, &never).unwrap();
+    }
+    let (rc, rg) = (c.recorder(ids[0]).unwrap(), g.recorder(ids[1]).unwrap());
+    assert!(rc.rows.len() >= 8);
+    assert_eq!(rc.rows.len(), rg.rows.len());
+    for (a, b) in rc.rows.iter().zip(&rg.rows) {
+        assert_eq!(a[0], b[0], "row times");
+        let rel = ((a[1] - b[1]) / a[1]).abs();
+        assert!(rel < 1e-14, "R_H.x differs by {rel:e}");
+    }
+}
+
+#[test]
+fn auto_explains_its_choice() {
+    if !gpu_present("auto_explains_its_choice") {
+        return;
+    }
+    let mut s = mirror_inwards(10.0, true);
+    s.set_backend(Backend::Auto);
+    let info = s.backend_info().unwrap();
+    assert!(info.starts_with("cpu: auto:"), "{info}");
+    s.set_model(Model::Rigid);
+    assert!(s.backend_info().unwrap().contains("rigid"));
+    s.set_backend(Backend::Gpu);
+    let e = s.backend_info().unwrap_err().to_string();
+    assert!(
+        e.contains("rigid") && e.contains("s.backend = \"cpu\""),
+        "{e}"
+    );
+}
+
+// Without an adapter (hidden by SWIMLAB_NO_GPU): "auto" runs on the CPU and says so; "gpu" is a
+// clear error at the script position, and the script stops there. Runs everywhere.
+#[test]
+fn without_an_adapter_auto_falls_back_and_gpu_refuses() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args([
+            "-e",
+            "let s = scene(); s.add(dumbbell(#{})); s.backend = \"auto\"; print(s.backend_info); s.run(1e-4); print(`t=${s.time}`); s.backend = \"gpu\";",
+        ])
+        .env("SWIMLAB_NO_GPU", "1")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stdout.contains("cpu: auto: no GPU adapter: SWIMLAB_NO_GPU is set"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("t=0.0001"), "{stdout}");
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("s.backend = \"gpu\": no GPU adapter"),
+        "{stderr}"
+    );
+}
