@@ -61,10 +61,13 @@ enum BenchKind {
     /// CPU against GPU: time per RK4 step against size (8 … 16,384 spheres or swimmers; --quick:
     /// up to 1,024), transfers included, both models; the crossover and the "auto" calibration.
     Backends,
+    /// The CPU pair kernel: RPY interactions per second at N = 4,096 spheres, serial and on 1 …
+    /// all cores, against the ~1e9 per core bound.
+    Pairs,
 }
 
 fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
-    use swimlab::bench::{backends, stability, work_precision};
+    use swimlab::bench::{backends, pairs, stability, work_precision};
     use swimlab::engine::Model;
     let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
     match which {
@@ -101,6 +104,18 @@ fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
             t.write_csv(std::path::Path::new("out/bench/stability.csv"))
                 .map_err(io)?;
             println!("\nCSV written to out/bench/stability.csv");
+        }
+        BenchKind::Pairs => {
+            let n = 4096;
+            let t = pairs::run(n, if quick { 3 } else { 11 });
+            println!(
+                "RPY product u_i = sum_j H_ij F_j, N = {n} spheres, N(N-1) interactions per product, vector unit {} (medians):\n{}",
+                swimlab::engine::pairs::vector_unit(),
+                t.render()
+            );
+            t.write_csv(std::path::Path::new("out/bench/pairs.csv"))
+                .map_err(io)?;
+            println!("\nCSV written to out/bench/pairs.csv");
         }
         BenchKind::Backends => {
             match swimlab::engine::gpu::device() {

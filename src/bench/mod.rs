@@ -2,6 +2,7 @@
 //! the engine only and measure on the machine at hand; figures are reported, never asserted.
 
 pub mod backends;
+pub mod pairs;
 pub mod stability;
 pub mod table;
 pub mod work_precision;

@@ -14,6 +14,7 @@ pub mod micro;
 pub mod mobility;
 pub mod model;
 pub mod observable;
+pub mod pairs;
 pub mod recorder;
 pub mod rigid;
 pub mod scene;

@@ -35,6 +35,8 @@ pub enum Observable {
     Polarization,
     /// Nematic order: largest eigenvalue of Q = ⟨3NN − I⟩/2.
     Nematic,
+    /// The smallest gap between the surfaces of any two spheres of the scene (m).
+    MinGap,
 }
 
 impl Observable {
@@ -54,6 +56,7 @@ impl Observable {
             Observable::DeltaDistanceH(i, j) => format!("dD_H_T[{i},{j}]"),
             Observable::Polarization => "polarization".into(),
             Observable::Nematic => "nematic".into(),
+            Observable::MinGap => "min_gap".into(),
         }
     }
 
@@ -65,7 +68,8 @@ impl Observable {
             | Observable::Length(_)
             | Observable::PairMean(..)
             | Observable::PairSeparation(..)
-            | Observable::DistanceH(..) => "m",
+            | Observable::DistanceH(..)
+            | Observable::MinGap => "m",
             Observable::Tension(_) => "N",
             Observable::DeltaDistanceH(..) => "ell",
             _ => "1",
@@ -104,7 +108,7 @@ impl Observable {
             | Observable::DistanceH(i, j)
             | Observable::DeltaQ(i, j)
             | Observable::DeltaDistanceH(i, j) => vec![i, j],
-            Observable::Polarization | Observable::Nematic => vec![],
+            Observable::Polarization | Observable::Nematic | Observable::MinGap => vec![],
         }
     }
 
@@ -170,7 +174,26 @@ impl Observable {
                 q /= s.count() as f64;
                 vec![SymmetricEigen::new(q).eigenvalues.max()]
             }
+            Observable::MinGap => vec![Self::min_gap(s)],
         })
+    }
+
+    /// The smallest sphere gap of the scene (m); +inf with fewer than two spheres.
+    fn min_gap(s: &Scene) -> f64 {
+        let n = 2 * s.count();
+        let mut soa = super::pairs::SoaSpheres::default();
+        soa.resize(n);
+        let mut radii = Vec::with_capacity(n);
+        for i in 0..s.count() {
+            let (a, b) = s.spheres(i);
+            let d = &s.swimmers()[i];
+            for (k, (p, r)) in [(a, d.a1), (b, d.a2)].into_iter().enumerate() {
+                let j = 2 * i + k;
+                (soa.x[j], soa.y[j], soa.z[j]) = (p.x, p.y, p.z);
+                radii.push(r);
+            }
+        }
+        super::pairs::min_gap(&soa, &radii, n >= 256).map_or(f64::INFINITY, |g| g.0)
     }
 
     /// Value of `obs` now and one period later, on a copy of the scene (the scene is not changed).

@@ -786,6 +786,11 @@ impl Scene {
         outcome
     }
 
+    /// Take over the recorders (and cached GPU buffers) of `old`, which this scene replaces.
+    pub fn adopt_recorders(&mut self, old: Scene) {
+        self.recorders = old.recorders;
+    }
+
     /// Attach a recorder; returns its id.
     pub fn add_recorder(&mut self, r: Recorder) -> usize {
         self.recorders.push(r);

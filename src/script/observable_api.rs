@@ -144,6 +144,7 @@ pub fn register(engine: &mut Engine) {
             },
         )
         .register_fn("polarization", || Observable::Polarization)
+        .register_fn("min_gap", || Observable::MinGap)
         .register_fn("nematic", || Observable::Nematic)
         .register_fn(
             "observe",

@@ -71,6 +71,55 @@ pub fn summary(s: &Scene) -> String {
     )
 }
 
+/// `s.add_random(d, n, phi, seed[, #{ aligned: [x, y, z], phase: p }])`: n copies of d at
+/// random non-overlapping places in a cube sized for sphere volume fraction phi, centred on the
+/// origin; random orientations and phases unless fixed by the options. The scene is unchanged if
+/// the placement fails.
+fn add_random(
+    s: &mut SceneHandle,
+    d: DumbbellSpec,
+    n: INT,
+    phi: &Dynamic,
+    seed: INT,
+    opts: &rhai::Map,
+) -> ScriptResult<INT> {
+    use crate::engine::build::{box_side, random_suspension, Orientations, Phases};
+    if n < 0 {
+        return Err(script_error(format!(
+            "add_random: the number of swimmers must be >= 0, got {n}"
+        )));
+    }
+    let phi = number("add_random: volume fraction", phi)?;
+    let mut orientations = Orientations::Random;
+    let mut phases = Phases::Random;
+    for (k, v) in opts {
+        match k.as_str() {
+            "aligned" => orientations = Orientations::Aligned(crate::engine::swimmer::unit_direction(super::convert::vector3("aligned", v)?).map_err(|e| script_error(format!("add_random: aligned: {e}")))?),
+            "phase" => phases = Phases::Equal(number("phase", v)?),
+            other => {
+                return Err(script_error(format!(
+                    "add_random: unknown option \"{other}\"; use aligned: [x, y, z] and/or phase: number"
+                )))
+            }
+        }
+    }
+    let mut trial = s.0.borrow().clone();
+    let side = lift(box_side(n as usize, &d.params, phi))?;
+    lift(random_suspension(
+        &mut trial,
+        n as usize,
+        d.params,
+        side,
+        orientations,
+        phases,
+        seed as u64,
+    ))?;
+    let mut scene = s.0.borrow_mut();
+    let recorders_kept = std::mem::replace(&mut *scene, trial);
+    scene.adopt_recorders(recorders_kept);
+    Ok(scene.count() as INT)
+}
+
 /// Register the `Scene` type and its methods and properties.
 pub fn register(engine: &mut Engine) {
     engine
@@ -95,6 +144,26 @@ pub fn register(engine: &mut Engine) {
                 d.type_name()
             )))
         },
+    );
+
+    engine.register_fn(
+        "add_random",
+        |s: &mut SceneHandle,
+         d: DumbbellSpec,
+         n: INT,
+         phi: Dynamic,
+         seed: INT|
+         -> ScriptResult<INT> { add_random(s, d, n, &phi, seed, &rhai::Map::new()) },
+    );
+    engine.register_fn(
+        "add_random",
+        |s: &mut SceneHandle,
+         d: DumbbellSpec,
+         n: INT,
+         phi: Dynamic,
+         seed: INT,
+         opts: rhai::Map|
+         -> ScriptResult<INT> { add_random(s, d, n, &phi, seed, &opts) },
     );
 
     // Properties.

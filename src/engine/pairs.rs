@@ -1,0 +1,226 @@
+//! The fast all-pairs kernel of the sphere models: u_i = Σ_{j≠i} H_ij F_j for thousands of spheres.
+//!
+//! Layout for SIMD: structure of arrays (x, y, z, radius, force components as separate f64
+//! slices); each row i runs over all j in blocks of [`LANES`] independent accumulators, which the
+//! compiler maps onto vector registers (AVX-512, AVX2+FMA or SSE2, chosen at run time). Rows are
+//! independent, so they run in parallel with rayon; every row sums in the same order whatever the
+//! thread count or the vector width (no fused multiply-add is formed: Rust never contracts), so
+//! results do not depend on either. The j = i term is removed by a select on r² = 0, not a branch.
+//!
+//! Each pair is evaluated from both ends (the symmetric half-loop of
+//! [`super::mobility::Mobility::interaction_velocities`] does half the arithmetic but scatters
+//! into two rows, which does not vectorise or parallelise); that kernel remains the reference and
+//! serves small scenes.
+
+use super::mobility::Mobility;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Independent accumulators per row (one AVX-512 register, two AVX2 registers).
+pub const LANES: usize = 8;
+/// Rows per parallel task.
+const ROWS_PER_TASK: usize = 32;
+
+/// Sphere data as structure of arrays.
+#[derive(Debug, Clone, Default)]
+pub struct SoaSpheres {
+    /// Positions (m).
+    pub x: Vec<f64>,
+    /// y (m).
+    pub y: Vec<f64>,
+    /// z (m).
+    pub z: Vec<f64>,
+    /// Radii squared (m²).
+    pub a2: Vec<f64>,
+    /// Forces (N).
+    pub fx: Vec<f64>,
+    /// y force.
+    pub fy: Vec<f64>,
+    /// z force.
+    pub fz: Vec<f64>,
+}
+
+impl SoaSpheres {
+    /// Resize to `n` spheres.
+    pub fn resize(&mut self, n: usize) {
+        for v in [
+            &mut self.x,
+            &mut self.y,
+            &mut self.z,
+            &mut self.a2,
+            &mut self.fx,
+            &mut self.fy,
+            &mut self.fz,
+        ] {
+            v.resize(n, 0.0);
+        }
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}
+
+/// Prefactors 1/(8πμ) and, for RPY, 1/(24πμ) (0 for Oseen).
+fn prefactors(m: Mobility, mu: f64) -> (f64, f64) {
+    let c3 = match m {
+        Mobility::Rpy => 1.0 / (24.0 * PI * mu),
+        Mobility::Oseen => 0.0,
+    };
+    (1.0 / (8.0 * PI * mu), c3)
+}
+
+/// u_i for the rows `first..first + u.len()`, written to `u` as (ux, uy, uz).
+#[inline(always)]
+fn rows_impl(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
+    let n = s.len();
+    let blocks = n / LANES;
+    for (k, out) in u.iter_mut().enumerate() {
+        let i = first + k;
+        let (xi, yi, zi, ai2) = (s.x[i], s.y[i], s.z[i], s.a2[i]);
+        let mut ax = [0.0; LANES];
+        let mut ay = [0.0; LANES];
+        let mut az = [0.0; LANES];
+        let term = |j: usize, x: f64, y: f64, z: f64, a2: f64, fx: f64, fy: f64, fz: f64| {
+            let _ = j;
+            let (rx, ry, rz) = (xi - x, yi - y, zi - z);
+            let r2 = rx * rx + ry * ry + rz * rz;
+            let inv = 1.0 / r2.sqrt();
+            let inv_r = if r2 > 0.0 { inv } else { 0.0 };
+            let inv_r2 = inv_r * inv_r;
+            let rdf = (rx * fx + ry * fy + rz * fz) * inv_r2;
+            let o = c1 * inv_r;
+            let f3 = c3 * (ai2 + a2) * inv_r * inv_r2;
+            let cf = o + f3;
+            let cr = (o - 3.0 * f3) * rdf;
+            (cf * fx + cr * rx, cf * fy + cr * ry, cf * fz + cr * rz)
+        };
+        for b in 0..blocks {
+            let o = b * LANES;
+            let x: &[f64; LANES] = s.x[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let y: &[f64; LANES] = s.y[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let z: &[f64; LANES] = s.z[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let a2: &[f64; LANES] = s.a2[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let fx: &[f64; LANES] = s.fx[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let fy: &[f64; LANES] = s.fy[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let fz: &[f64; LANES] = s.fz[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            for l in 0..LANES {
+                let (tx, ty, tz) = term(o + l, x[l], y[l], z[l], a2[l], fx[l], fy[l], fz[l]);
+                ax[l] += tx;
+                ay[l] += ty;
+                az[l] += tz;
+            }
+        }
+        for j in blocks * LANES..n {
+            let (tx, ty, tz) = term(
+                j, s.x[j], s.y[j], s.z[j], s.a2[j], s.fx[j], s.fy[j], s.fz[j],
+            );
+            ax[0] += tx;
+            ay[0] += ty;
+            az[0] += tz;
+        }
+        *out = [lane_sum(&ax), lane_sum(&ay), lane_sum(&az)];
+    }
+}
+
+/// Sum of the lanes in a fixed pairwise order.
+#[inline(always)]
+fn lane_sum(a: &[f64; LANES]) -> f64 {
+    ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]))
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn rows_avx512(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
+    rows_impl(s, c1, c3, first, u)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn rows_avx2(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
+    rows_impl(s, c1, c3, first, u)
+}
+
+/// The widest vector unit this CPU has, for the report.
+pub fn vector_unit() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx512f") {
+            return "avx512f";
+        }
+        if std::is_x86_feature_detected!("avx2") {
+            return "avx2";
+        }
+    }
+    "baseline"
+}
+
+fn rows(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            return unsafe { rows_avx512(s, c1, c3, first, u) };
+        }
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { rows_avx2(s, c1, c3, first, u) };
+        }
+    }
+    rows_impl(s, c1, c3, first, u)
+}
+
+/// u_i = Σ_{j≠i} H_ij F_j for every sphere, rows in parallel (on rayon's pool) when `parallel`.
+pub fn interaction_velocities(
+    m: Mobility,
+    mu: f64,
+    s: &SoaSpheres,
+    u: &mut [[f64; 3]],
+    parallel: bool,
+) {
+    let (c1, c3) = prefactors(m, mu);
+    if parallel {
+        u.par_chunks_mut(ROWS_PER_TASK)
+            .enumerate()
+            .for_each(|(c, chunk)| rows(s, c1, c3, c * ROWS_PER_TASK, chunk));
+    } else {
+        rows(s, c1, c3, 0, u);
+    }
+}
+
+/// The smallest gap |x_i − x_j| − a_i − a_j over all pairs and a pair that has it (rows in
+/// parallel when `parallel`). `None` for fewer than two spheres.
+pub fn min_gap(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f64, usize, usize)> {
+    let n = s.len();
+    let row = |i: usize| -> Option<(f64, usize, usize)> {
+        let mut best: Option<(f64, usize, usize)> = None;
+        for j in i + 1..n {
+            let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
+            let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
+            if best.is_none_or(|b| gap < b.0) {
+                best = Some((gap, i, j));
+            }
+        }
+        best
+    };
+    let pick = |a: Option<(f64, usize, usize)>, b: Option<(f64, usize, usize)>| match (a, b) {
+        (Some(x), Some(y)) => Some(if y.0 < x.0 || (y.0 == x.0 && y.1 < x.1) {
+            y
+        } else {
+            x
+        }),
+        (x, None) => x,
+        (None, y) => y,
+    };
+    if parallel {
+        (0..n).into_par_iter().map(row).reduce(|| None, pick)
+    } else {
+        (0..n).map(row).fold(None, pick)
+    }
+}

@@ -1,0 +1,81 @@
+//! The vectorised, parallel pair kernel against the reference half-loop, and its independence of
+//! the thread count.
+
+use nalgebra::Vector3;
+use swimlab::bench::pairs::lattice;
+use swimlab::engine::pairs::{interaction_velocities, min_gap};
+use swimlab::engine::Mobility;
+
+fn reference(m: Mobility, s: &swimlab::engine::pairs::SoaSpheres) -> Vec<Vector3<f64>> {
+    let n = s.len();
+    let pos: Vec<_> = (0..n)
+        .map(|i| Vector3::new(s.x[i], s.y[i], s.z[i]))
+        .collect();
+    let radii: Vec<_> = s.a2.iter().map(|a2| a2.sqrt()).collect();
+    let f: Vec<_> = (0..n)
+        .map(|i| Vector3::new(s.fx[i], s.fy[i], s.fz[i]))
+        .collect();
+    let mut u = vec![Vector3::zeros(); n];
+    m.interaction_velocities(1e-3, &pos, &radii, &f, &mut u);
+    u
+}
+
+// The two kernels sum the same ~N terms in different orders (and the radii pass through a square
+// root and back): each u differs by a few ulps of the largest term, far below 1e-12 of |u|max.
+#[test]
+fn fast_kernel_matches_the_reference_to_round_off() {
+    for m in [Mobility::Rpy, Mobility::Oseen] {
+        for n in [5usize, 67, 300] {
+            let s = lattice(n);
+            let r = reference(m, &s);
+            let mut u = vec![[0.0; 3]; n];
+            interaction_velocities(m, 1e-3, &s, &mut u, false);
+            let scale = r.iter().map(|v| v.amax()).fold(0.0, f64::max);
+            let err = (0..n)
+                .flat_map(|i| (0..3).map(move |k| (i, k)))
+                .map(|(i, k)| (u[i][k] - r[i][k]).abs())
+                .fold(0.0, f64::max);
+            assert!(err <= 1e-12 * scale, "{m:?} n = {n}: {err:e} of {scale:e}");
+        }
+    }
+}
+
+// Every row sums in a fixed order whatever runs it: serial, 1 thread or 2 threads give the same bits.
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let s = lattice(1000);
+    let mut serial = vec![[0.0; 3]; s.len()];
+    interaction_velocities(Mobility::Rpy, 1e-3, &s, &mut serial, false);
+    for threads in [1, 2, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut u = vec![[0.0; 3]; s.len()];
+        pool.install(|| interaction_velocities(Mobility::Rpy, 1e-3, &s, &mut u, true));
+        assert_eq!(u, serial, "{threads} threads");
+    }
+}
+
+#[test]
+fn min_gap_finds_the_closest_pair() {
+    let mut s = lattice(200);
+    s.x[150] = s.x[17] + 1.1e-6;
+    s.y[150] = s.y[17];
+    s.z[150] = s.z[17];
+    let radii: Vec<f64> = s.a2.iter().map(|a| a.sqrt()).collect();
+    let brute = (0..200)
+        .flat_map(|i| (i + 1..200).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let d =
+                ((s.x[i] - s.x[j]).powi(2) + (s.y[i] - s.y[j]).powi(2) + (s.z[i] - s.z[j]).powi(2))
+                    .sqrt();
+            d - radii[i] - radii[j]
+        })
+        .fold(f64::INFINITY, f64::min);
+    for parallel in [false, true] {
+        let (gap, i, j) = min_gap(&s, &radii, parallel).unwrap();
+        assert_eq!(gap, brute);
+        assert_eq!((i, j), (17, 150));
+    }
+}
