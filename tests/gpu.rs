@@ -73,6 +73,7 @@ fn one_step_agrees_to_round_off_micro() {
     ] {
         let dt = s.default_micro_step();
         let m = one_step_mismatch(&s, dt);
+        eprintln!("micro one step: mismatch {m:?}");
         assert!(
             m[0] <= 1e-12 && m[1] <= 1e-12,
             "micro one-step mismatch {m:?}"
@@ -103,6 +104,7 @@ fn one_step_agrees_to_round_off_averaged() {
     )
     .unwrap();
     let m = one_step_mismatch(&s, 100.0 * d.period());
+    eprintln!("averaged one step: mismatch {m:?}");
     assert!(
         m[0] <= 1e-12 && m[1] <= 1e-12,
         "averaged one-step mismatch {m:?}"

@@ -20,7 +20,7 @@ pub struct Row {
 }
 
 /// Skip a backend at sizes where the last step time, scaled by N², would exceed this (s).
-const BUDGET_PER_STEP: f64 = 4.0;
+const BUDGET_PER_STEP: f64 = 20.0;
 
 /// Measure both backends at sizes 8 … `max` (doubling), both models.
 pub fn run(max: usize) -> Vec<Row> {
