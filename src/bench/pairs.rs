@@ -4,7 +4,7 @@
 
 use super::table::Table;
 use crate::engine::mobility::Mobility;
-use crate::engine::pairs::{interaction_velocities, vector_unit, SoaSpheres};
+use crate::engine::pairs::{interaction_velocities, SoaSpheres};
 use std::time::Instant;
 
 /// Interactions per second per core that the arithmetic allows (issue 7's bound).
@@ -81,6 +81,5 @@ pub fn run(n: usize, repeats: usize) -> Table {
         let secs = pool.install(|| time_product(&s, true, repeats));
         row(format!("{threads} (rayon)"), secs, threads);
     }
-    let _ = vector_unit;
     t
 }

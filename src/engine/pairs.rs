@@ -87,8 +87,7 @@ fn rows_impl(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]])
         let mut ax = [0.0; LANES];
         let mut ay = [0.0; LANES];
         let mut az = [0.0; LANES];
-        let term = |j: usize, x: f64, y: f64, z: f64, a2: f64, fx: f64, fy: f64, fz: f64| {
-            let _ = j;
+        let term = |x: f64, y: f64, z: f64, a2: f64, fx: f64, fy: f64, fz: f64| {
             let (rx, ry, rz) = (xi - x, yi - y, zi - z);
             let r2 = rx * rx + ry * ry + rz * rz;
             let inv = 1.0 / r2.sqrt();
@@ -111,16 +110,14 @@ fn rows_impl(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]])
             let fy: &[f64; LANES] = s.fy[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             let fz: &[f64; LANES] = s.fz[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             for l in 0..LANES {
-                let (tx, ty, tz) = term(o + l, x[l], y[l], z[l], a2[l], fx[l], fy[l], fz[l]);
+                let (tx, ty, tz) = term(x[l], y[l], z[l], a2[l], fx[l], fy[l], fz[l]);
                 ax[l] += tx;
                 ay[l] += ty;
                 az[l] += tz;
             }
         }
         for j in blocks * LANES..n {
-            let (tx, ty, tz) = term(
-                j, s.x[j], s.y[j], s.z[j], s.a2[j], s.fx[j], s.fy[j], s.fz[j],
-            );
+            let (tx, ty, tz) = term(s.x[j], s.y[j], s.z[j], s.a2[j], s.fx[j], s.fy[j], s.fz[j]);
             ax[0] += tx;
             ay[0] += ty;
             az[0] += tz;

@@ -786,7 +786,7 @@ impl Scene {
         outcome
     }
 
-    /// Take over the recorders (and cached GPU buffers) of `old`, which this scene replaces.
+    /// Take over the recorders of `old`, which this scene replaces.
     pub fn adopt_recorders(&mut self, old: Scene) {
         self.recorders = old.recorders;
     }
