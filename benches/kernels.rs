@@ -76,8 +76,14 @@ fn systems(model: Model) -> (Box<dyn OdeSystem>, Vec<f64>) {
     s.set_model(model);
     let (y, base) = s.raw_state();
     let sys: Box<dyn OdeSystem> = match model {
-        Model::Micro => Box::new(MicroSystem::new(s.swimmers(), base, 1e-3, Mobility::Rpy)),
-        Model::Rigid => Box::new(RigidSystem::new(s.swimmers(), base, 1e-3, Mobility::Rpy)),
+        Model::Micro => Box::new(MicroSystem::new(
+            s.swimmers(),
+            base,
+            1e-3,
+            Mobility::Rpy,
+            Default::default(),
+        )),
+        Model::Rigid => Box::new(RigidSystem::new(s.swimmers(), base, 1e-3, Mobility::Rpy, false)),
         Model::Averaged => Box::new(AveragedSystem::new(
             s.swimmers(),
             base,

@@ -113,3 +113,65 @@ fn interaction_kernel_equals_matrix_product_without_self_terms() {
         }
     }
 }
+
+/// `n` spheres with radii in [0.5, 1.5] µm placed anywhere in the box: many overlap, some lie
+/// inside others.
+fn overlapping_spheres(rng: &mut Rng, n: usize, box_size: f64) -> (Vec<Vector3<f64>>, Vec<f64>) {
+    let radii = (0..n).map(|_| 0.5e-6 + 1e-6 * rng.uniform()).collect();
+    let pos = (0..n)
+        .map(|_| Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()) * box_size)
+        .collect();
+    (pos, radii)
+}
+
+// Zuk et al. (2014) built the overlapping form so that the RPY mobility stays positive definite for
+// any configuration; Mazur's form alone loses that once spheres overlap. Eigenvalues are compared
+// with the largest: a negative one at −1e-3 of it would be a wrong formula, round-off is ~1e-16.
+#[test]
+fn rpy_stays_positive_definite_when_spheres_overlap() {
+    let mut rng = Rng(0x2545f4914f6cdd1d);
+    let mut overlapping_configs = 0;
+    for trial in 0..60 {
+        let n = 2 + trial % 15;
+        let (pos, radii) = overlapping_spheres(&mut rng, n, 2e-6 * (n as f64).cbrt());
+        let overlaps = (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .any(|(i, j)| (pos[i] - pos[j]).norm() < radii[i] + radii[j]);
+        overlapping_configs += overlaps as usize;
+        let m = Mobility::Rpy.matrix(MU, &pos, &radii);
+        let asym = (&m - m.transpose()).amax() / m.amax();
+        assert!(asym < 1e-15, "asymmetry {asym:e}");
+        let eig = m.symmetric_eigenvalues();
+        let min = eig.min() / eig.max();
+        assert!(min > 0.0, "trial {trial}: smallest eigenvalue ratio {min:e}");
+    }
+    assert!(overlapping_configs > 50, "the configurations must overlap");
+}
+
+// At contact d = a_i + a_j the overlapping form meets Mazur's; at d = |a_i − a_j| (one sphere just
+// inside the other) it meets the larger sphere's drag. Both sides are evaluated 1e-9 of a radius
+// apart: the tensor's slope is ~1/(μ a²), so the jump allowed is ~1e-9 of the value (2e-9 taken).
+#[test]
+fn overlapping_form_is_continuous_with_mazur_at_contact_and_with_drag_inside() {
+    let r_hat = Vector3::new(2.0, -1.0, 2.0) / 3.0;
+    for (ai, aj) in [(1e-6f64, 1e-6f64), (0.7e-6, 1.3e-6), (1.5e-6, 0.4e-6)] {
+        let eps = 1e-9 * ai.min(aj);
+        for (d, inner) in [(ai + aj, false), ((ai - aj).abs(), true)] {
+            if d == 0.0 {
+                continue;
+            }
+            let out = Mobility::Rpy.pair_tensor(MU, &(r_hat * (d + eps)), ai, aj);
+            let inn = Mobility::Rpy.pair_tensor(MU, &(r_hat * (d - eps)), ai, aj);
+            let jump = (out - inn).amax() / out.amax();
+            assert!(jump < 2e-9, "a = ({ai:e}, {aj:e}), d = {d:e}: jump {jump:e}");
+            if inner {
+                let drag = Matrix3::identity() / (6.0 * PI * MU * ai.max(aj));
+                assert!((inn - drag).amax() < 1e-12 * drag.amax());
+            }
+        }
+    }
+    // Equal spheres on top of each other move as one: the block is the single-sphere drag.
+    let h = Mobility::Rpy.pair_tensor(MU, &Vector3::new(1e-15, 0.0, 0.0), 1e-6, 1e-6);
+    let drag = 1.0 / (6.0 * PI * MU * 1e-6);
+    assert!((h[(0, 0)] - drag).abs() < 1e-8 * drag && (h[(1, 1)] - drag).abs() < 1e-8 * drag);
+}

@@ -22,7 +22,7 @@ pub fn lattice(n: usize) -> SoaSpheres {
         s.y[k] = j as f64 * 3e-6 + jitter;
         s.z[k] = l as f64 * 3e-6 + jitter;
         let a = 0.5e-6 + 0.5e-6 * ((k * 31) % 17) as f64 / 17.0;
-        s.a2[k] = a * a;
+        s.set_radius(k, a);
         let f = 1e-12 * (1.0 + (k % 3) as f64);
         s.fx[k] = f;
         s.fy[k] = -0.5 * f;

@@ -14,6 +14,7 @@ use super::integrators::{OdeSystem, Problem};
 use super::model::{set_vec3, vec3, Coefficients, STATE_PER_SWIMMER};
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
+use rayon::prelude::*;
 
 /// |sin(Δφ)| below this counts as zero: phases given as 0 and π differ by rounding only.
 const SIN_ZERO: f64 = 1e-14;
@@ -100,18 +101,50 @@ pub(crate) fn pair_constants(d: &Dumbbell, set: Coefficients) -> [f64; 8] {
     [c.a_r, c.c_j, c.a_n, c.v0, c.w0, c.big_l, c.ell, c.phase]
 }
 
+/// From this many swimmers on, the rows of the pair sums run in parallel (a row costs ~S × 60 ns,
+/// so 256 rows are ≳ 4 ms of work against rayon's few-µs dispatch).
+pub const PARALLEL_SWIMMERS: usize = 256;
+
+/// Centres and orientations as structure of arrays, refilled at every right-hand side.
+#[derive(Debug, Clone, Default)]
+struct Soa {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    nx: Vec<f64>,
+    ny: Vec<f64>,
+    nz: Vec<f64>,
+}
+
 /// The stroke-averaged right-hand side.
+///
+/// Every row σ sums over all ρ in index order (sin(φσ − φρ) from the stored sin φ and cos φ, so no
+/// pair list is kept: memory is O(S)), rows run in parallel from [`PARALLEL_SWIMMERS`] on, and a
+/// row's sum does not depend on the thread count. Nothing is allocated per call.
+///
+/// Far-field cutoff ([`AveragedSystem::set_cutoff`], off by default): pairs further apart than D_c
+/// are left out. Each term of a pair at distance D ≥ D_c is bounded with |sin| ≤ 1 and every
+/// bracket bounded term by term (|N·D̂|, |q| ≤ 1):
+/// |ΔdR_H/dt| ≤ (9/64) v0 [28 |A_R| (Λ/ℓ) ξ³ + 84 c_J ξ⁴] and
+/// |ΔdN/dt| ≤ w0 (Λ/ℓ) [(15/64)·148 ξ⁵ + (9/32)·68 |A_N| ξ⁴], ξ = ℓ/D_c, per left-out pair
+/// ([`AveragedSystem::far_pair_bound`]); a swimmer's error is at most the number of pairs it
+/// leaves out times that. The D⁻³ term of asymmetric swimmers decays slowest: in a uniform
+/// suspension the number of pairs in a shell grows as D², so the cutoff suits symmetric swimmers
+/// (D⁻⁴ and faster) or a dilute scene best.
 #[derive(Debug, Clone)]
 pub struct AveragedSystem {
     coef: Vec<Coef>,
     base: Vec<Vector3<f64>>,
-    /// Interacting ordered pairs (σ, ρ, sin(φσ − φρ)); pairs with sin = 0 are left out.
-    pairs: Vec<(usize, usize, f64)>,
+    sin_phi: Vec<f64>,
+    cos_phi: Vec<f64>,
+    soa: Soa,
+    skip_zero_phase: bool,
+    /// D_c² (m²); infinite without a cutoff.
+    cutoff2: f64,
     /// The common axis when every centre and orientation lies on one line.
     axis: Option<Vector3<f64>>,
     scale_r: Vec<f64>,
     scale_n: Vec<f64>,
-    torque: Vec<Vector3<f64>>,
     skip_symmetric: bool,
 }
 
@@ -131,14 +164,17 @@ impl AveragedSystem {
         shortcuts: Shortcuts,
     ) -> Self {
         let coef: Vec<Coef> = swimmers.iter().map(|d| Coef::new(d, set)).collect();
-        let mut pairs = Vec::new();
-        for (s, cs) in coef.iter().enumerate() {
-            for (r, cr) in coef.iter().enumerate() {
-                let sin = (cs.phase - cr.phase).sin();
-                if s != r && (sin.abs() > SIN_ZERO || !shortcuts.skip_zero_phase_pairs) {
-                    pairs.push((s, r, sin));
-                }
-            }
+        let n = coef.len();
+        let mut soa = Soa::default();
+        for v in [
+            &mut soa.x,
+            &mut soa.y,
+            &mut soa.z,
+            &mut soa.nx,
+            &mut soa.ny,
+            &mut soa.nz,
+        ] {
+            v.resize(n, 0.0);
         }
         let mut sys = AveragedSystem {
             scale_r: swimmers.iter().map(Dumbbell::drift_scale).collect(),
@@ -147,17 +183,37 @@ impl AveragedSystem {
                 .iter()
                 .map(|d| d.drift_scale() / d.stroke_scale())
                 .collect(),
+            sin_phi: coef.iter().map(|c| c.phase.sin()).collect(),
+            cos_phi: coef.iter().map(|c| c.phase.cos()).collect(),
             coef,
             base: base.to_vec(),
-            pairs,
+            soa,
+            skip_zero_phase: shortcuts.skip_zero_phase_pairs,
+            cutoff2: f64::INFINITY,
             axis: None,
-            torque: vec![Vector3::zeros(); swimmers.len()],
             skip_symmetric: shortcuts.skip_symmetric_terms,
         };
         if shortcuts.aligned_1d {
             sys.axis = sys.common_axis(y);
         }
         sys
+    }
+
+    /// Leave out pairs further apart than `cutoff` (m); `None` keeps every pair.
+    pub fn set_cutoff(&mut self, cutoff: Option<f64>) {
+        self.cutoff2 = cutoff.map_or(f64::INFINITY, |c| c * c);
+    }
+
+    /// Bounds on what one pair at distance `distance` (m) adds to swimmer σ's dR_H/dt (m/s) and
+    /// dN/dt (1/s): the error per pair a cutoff at that distance makes (see the type's doc).
+    pub fn far_pair_bound(&self, s: usize, distance: f64) -> (f64, f64) {
+        let c = &self.coef[s];
+        let xi = c.ell / distance;
+        let v = 9.0 / 64.0 * c.v0 * (28.0 * c.a_r.abs() * c.big_l * xi.powi(3) + 84.0 * c.c_j * xi.powi(4));
+        let w = c.w0
+            * c.big_l
+            * (15.0 / 64.0 * 148.0 * xi.powi(5) + 9.0 / 32.0 * 68.0 * c.a_n.abs() * xi.powi(4));
+        (v, w)
     }
 
     /// Whether the 1D reduction is in use.
@@ -186,54 +242,52 @@ impl AveragedSystem {
             .then_some(axis)
     }
 
-    fn rhs_aligned(&self, axis: &Vector3<f64>, y: &[f64], dy: &mut [f64]) {
-        dy.fill(0.0);
-        let x: Vec<f64> = (0..self.coef.len())
-            .map(|s| self.center(y, s).dot(axis))
-            .collect();
-        for &(s, r, sin) in &self.pairs {
-            let c = &self.coef[s];
-            let d = x[s] - x[r];
-            let xi = c.ell / d.abs();
-            let n = vec3(y, STATE_PER_SWIMMER * s + 3).dot(axis).signum();
-            let v = 9.0 / 16.0
-                * c.v0
-                * sin
-                * (c.a_r * c.big_l * xi.powi(3) * n + c.c_j * xi.powi(4) * d.signum());
-            let i = STATE_PER_SWIMMER * s;
-            for k in 0..3 {
-                dy[i + k] += v * axis[k];
+    /// Fill the structure of arrays from the state `y`.
+    fn fill(&mut self, y: &[f64]) {
+        for s in 0..self.coef.len() {
+            let c = self.center(y, s);
+            let n = vec3(y, STATE_PER_SWIMMER * s + 3);
+            let soa = &mut self.soa;
+            (soa.x[s], soa.y[s], soa.z[s]) = (c.x, c.y, c.z);
+            (soa.nx[s], soa.ny[s], soa.nz[s]) = (n.x, n.y, n.z);
+        }
+    }
+
+    /// sin(φσ − φρ) if the pair interacts (it is not skipped as a zero-phase pair).
+    #[inline]
+    fn pair_sin(&self, s: usize, r: usize) -> Option<f64> {
+        let sin = self.sin_phi[s] * self.cos_phi[r] - self.cos_phi[s] * self.sin_phi[r];
+        (s != r && (sin.abs() > SIN_ZERO || !self.skip_zero_phase)).then_some(sin)
+    }
+
+    /// dR_H/dt of swimmer σ and the torque-like sum T (dN/dt = −(1 − NNᵀ) T), from the arrays.
+    fn row(&self, s: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let c = &self.coef[s];
+        let soa = &self.soa;
+        let ns = Vector3::new(soa.nx[s], soa.ny[s], soa.nz[s]);
+        let with_i = c.a_r != 0.0 || !self.skip_symmetric;
+        let with_k = c.a_n != 0.0 || !self.skip_symmetric;
+        let mut v = Vector3::zeros();
+        let mut t = Vector3::zeros();
+        for r in 0..self.coef.len() {
+            let Some(sin) = self.pair_sin(s, r) else {
+                continue;
+            };
+            let dvec = Vector3::new(soa.x[s] - soa.x[r], soa.y[s] - soa.y[r], soa.z[s] - soa.z[r]);
+            let d2 = dvec.norm_squared();
+            if d2 > self.cutoff2 {
+                continue;
             }
-        }
-    }
-}
-
-impl OdeSystem for AveragedSystem {
-    fn dim(&self) -> usize {
-        STATE_PER_SWIMMER * self.coef.len()
-    }
-
-    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
-        if let Some(axis) = self.axis {
-            return self.rhs_aligned(&axis, y, dy);
-        }
-        dy.fill(0.0);
-        let mut torque = std::mem::take(&mut self.torque);
-        torque.fill(Vector3::zeros());
-        for &(s, r, sin) in &self.pairs {
-            let c = &self.coef[s];
-            let dvec = self.center(y, s) - self.center(y, r);
-            let dist = dvec.norm();
+            let dist = d2.sqrt();
             let dh = dvec / dist;
-            let ns = vec3(y, STATE_PER_SWIMMER * s + 3);
-            let nr = vec3(y, STATE_PER_SWIMMER * r + 3);
+            let nr = Vector3::new(soa.nx[r], soa.ny[r], soa.nz[r]);
             let (ss, rr, q) = (dh.dot(&ns), dh.dot(&nr), ns.dot(&nr));
             let xi = c.ell / dist;
             let (xi3, xi4) = (xi.powi(3), xi.powi(4));
             // The bracket shared by J and K.
             let jk = 1.0 + 2.0 * q * q - 5.0 * ss * ss - 5.0 * rr * rr - 20.0 * q * ss * rr
                 + 35.0 * ss * ss * rr * rr;
-            let mut v = c.c_j
+            v += c.c_j
                 * c.v0
                 * sin
                 * (9.0 / 64.0)
@@ -250,27 +304,87 @@ impl OdeSystem for AveragedSystem {
                     - 21.0 * ss * rr * rr
                     - 42.0 * q * ss * ss * rr
                     + 63.0 * ss.powi(3) * rr * rr);
-            let mut t = dh * l;
-            if c.a_r != 0.0 || !self.skip_symmetric {
+            let mut tr = dh * l;
+            if with_i {
                 let i_br = 1.0 - 3.0 * rr * rr - 3.0 * ss * ss - 6.0 * q * ss * rr
                     + 15.0 * ss * ss * rr * rr;
                 v += ns * (c.a_r * c.v0 * sin * (9.0 / 64.0) * c.big_l * xi3 * i_br);
             }
-            if c.a_n != 0.0 || !self.skip_symmetric {
-                t += dh * (c.a_n * c.w0 * sin * (9.0 / 32.0) * c.big_l * xi4 * jk);
+            if with_k {
+                tr += dh * (c.a_n * c.w0 * sin * (9.0 / 32.0) * c.big_l * xi4 * jk);
             }
-            let i = STATE_PER_SWIMMER * s;
-            for k in 0..3 {
-                dy[i + k] += v[k];
-            }
-            torque[s] += t;
+            t += tr;
         }
-        for (s, t) in torque.iter().enumerate() {
+        (v, t)
+    }
+
+    /// The 1D reduction: speed of swimmer σ along the axis (its centre coordinate in `soa.x`).
+    fn row_aligned(&self, s: usize) -> f64 {
+        let c = &self.coef[s];
+        let xs = self.soa.x[s];
+        let n = self.soa.nx[s].signum();
+        let mut v = 0.0;
+        for r in 0..self.coef.len() {
+            let Some(sin) = self.pair_sin(s, r) else {
+                continue;
+            };
+            let d = xs - self.soa.x[r];
+            if d * d > self.cutoff2 {
+                continue;
+            }
+            let xi = c.ell / d.abs();
+            v += 9.0 / 16.0
+                * c.v0
+                * sin
+                * (c.a_r * c.big_l * xi.powi(3) * n + c.c_j * xi.powi(4) * d.signum());
+        }
+        v
+    }
+
+    /// Fill `dy` row by row (in parallel for large scenes).
+    fn rows_into(&self, y: &[f64], dy: &mut [f64]) {
+        let one = |s: usize, out: &mut [f64]| {
+            if let Some(axis) = self.axis {
+                let v = self.row_aligned(s) * axis;
+                out[..3].copy_from_slice(v.as_slice());
+                out[3..6].fill(0.0);
+                return;
+            }
+            let (v, t) = self.row(s);
             let n = vec3(y, STATE_PER_SWIMMER * s + 3);
-            let dn = -(t - n * n.dot(t));
-            set_vec3(dy, STATE_PER_SWIMMER * s + 3, &dn);
+            let dn = -(t - n * n.dot(&t));
+            out[..3].copy_from_slice(v.as_slice());
+            out[3..6].copy_from_slice(dn.as_slice());
+        };
+        if self.coef.len() >= PARALLEL_SWIMMERS {
+            dy.par_chunks_mut(STATE_PER_SWIMMER)
+                .enumerate()
+                .for_each(|(s, out)| one(s, out));
+        } else {
+            dy.chunks_mut(STATE_PER_SWIMMER)
+                .enumerate()
+                .for_each(|(s, out)| one(s, out));
         }
-        self.torque = torque;
+    }
+}
+
+impl OdeSystem for AveragedSystem {
+    fn dim(&self) -> usize {
+        STATE_PER_SWIMMER * self.coef.len()
+    }
+
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
+        match self.axis {
+            Some(axis) => {
+                // Centre coordinates along the axis in `x`, the orientation's in `nx`.
+                for s in 0..self.coef.len() {
+                    self.soa.x[s] = self.center(y, s).dot(&axis);
+                    self.soa.nx[s] = vec3(y, STATE_PER_SWIMMER * s + 3).dot(&axis);
+                }
+            }
+            None => self.fill(y),
+        }
+        self.rows_into(y, dy);
     }
 
     /// Centres against the closest pair's per-period drift scale (as in the microscopic model),
@@ -284,17 +398,31 @@ impl OdeSystem for AveragedSystem {
     }
 
     fn check(&mut self, _t: f64, y: &[f64]) -> Result<(), Problem> {
-        for &(s, r, _) in &self.pairs {
-            if s < r && (self.center(y, s) - self.center(y, r)).norm() == 0.0 {
-                return Err(Problem {
-                    swimmer: Some(s),
-                    cause: format!("swimmers {s} and {r} have the same centre"),
-                    hint: "start the swimmers apart: the averaged model is a far-field model"
-                        .into(),
-                });
-            }
+        self.fill(y);
+        let soa = &self.soa;
+        let n = self.coef.len();
+        let row = |s: usize| {
+            (s + 1..n).find(|&r| {
+                self.pair_sin(s, r).is_some()
+                    && soa.x[s] == soa.x[r]
+                    && soa.y[s] == soa.y[r]
+                    && soa.z[s] == soa.z[r]
+            })
+            .map(|r| (s, r))
+        };
+        let found = if n >= PARALLEL_SWIMMERS {
+            (0..n).into_par_iter().find_map_first(row)
+        } else {
+            (0..n).find_map(row)
+        };
+        match found {
+            Some((s, r)) => Err(Problem {
+                swimmer: Some(s),
+                cause: format!("swimmers {s} and {r} have the same centre"),
+                hint: "start the swimmers apart: the averaged model is a far-field model".into(),
+            }),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// Renormalise every N (the projector keeps dN/dt tangent; the step leaves it off by O(h²)).

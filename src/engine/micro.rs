@@ -7,6 +7,7 @@
 //!   because the dumbbell is force-free, so they are never added (no cancellation in floating point);
 //! - db/dt = −f (1/γ₁ + 1/γ₂) + u₂ − u₁, γ = 6πμa.
 
+use super::contacts::Contacts;
 use super::integrators::{OdeSystem, Problem};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
@@ -24,11 +25,17 @@ pub struct MicroSystem {
 
 impl MicroSystem {
     /// A system for these swimmers, base positions, viscosity and mobility.
-    pub fn new(swimmers: &[Dumbbell], base: &[Vector3<f64>], mu: f64, mobility: Mobility) -> Self {
+    pub fn new(
+        swimmers: &[Dumbbell],
+        base: &[Vector3<f64>],
+        mu: f64,
+        mobility: Mobility,
+        contacts: Contacts,
+    ) -> Self {
         MicroSystem {
             swimmers: swimmers.to_vec(),
             base: base.to_vec(),
-            spheres: Spheres::new(swimmers, mu, mobility),
+            spheres: Spheres::new(swimmers, mu, mobility, contacts),
         }
     }
 

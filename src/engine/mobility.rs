@@ -1,5 +1,5 @@
 //! Hydrodynamic mobility of spheres in Stokes flow (e:Mazur): the Rotne-Prager-Yamakawa tensor for
-//! unequal radii (Mazur's form) and its Oseen truncation.
+//! unequal radii (Mazur's form; Zuk et al.'s for overlapping spheres) and its Oseen truncation.
 //!
 //! Self terms are H_αα = I/(6πμa_α). The kernels here compute the *interaction* part
 //! u_α = Σ_{β≠α} H_αβ F_β only; callers add the Stokes drag F_α/(6πμa_α) themselves. Keeping the two
@@ -42,6 +42,38 @@ impl Mobility {
         }
     }
 
+    /// The pair block as H_αβ = c_I I + c_rr r̂r̂ for spheres of radii `ai`, `aj` a distance `d`
+    /// apart: (c_I, c_rr).
+    ///
+    /// RPY: Mazur's form for separated spheres (d > ai + aj), and for overlapping ones the form of
+    /// Zuk, Wajnryb, Mizerski & Szymczak (J. Fluid Mech. 741, R5, 2014), which keeps the mobility
+    /// positive definite and is continuous with Mazur's at contact and with a single sphere's
+    /// drag 1/(6πμ max(ai, aj)) when one sphere lies inside the other:
+    /// c_I = [16d³(ai+aj) − ((ai−aj)² + 3d²)²] / (32d³ · 6πμ ai aj),
+    /// c_rr = 3((ai−aj)² − d²)² / (32d³ · 6πμ ai aj).
+    /// Oseen has no finite size and keeps its point-force form at every distance.
+    #[inline]
+    pub fn pair_coefficients(self, mu: f64, d: f64, ai: f64, aj: f64) -> (f64, f64) {
+        let oseen = 1.0 / (8.0 * PI * mu * d);
+        match self {
+            Mobility::Oseen => (oseen, oseen),
+            Mobility::Rpy if d > ai + aj => {
+                let f = (ai * ai + aj * aj) / (24.0 * PI * mu * d * d * d);
+                (oseen + f, oseen - 3.0 * f)
+            }
+            Mobility::Rpy if d <= (ai - aj).abs() => (self_mobility(mu, ai.max(aj)), 0.0),
+            Mobility::Rpy => {
+                let (dm, d3) = ((ai - aj) * (ai - aj), d * d * d);
+                let scale = 1.0 / (32.0 * d3 * 6.0 * PI * mu * ai * aj);
+                let b = dm + 3.0 * d * d;
+                (
+                    (16.0 * d3 * (ai + aj) - b * b) * scale,
+                    3.0 * (dm - d * d) * (dm - d * d) * scale,
+                )
+            }
+        }
+    }
+
     /// H_αβ F for spheres of radii `ai`, `aj` at separation `r` = x_α − x_β (α ≠ β).
     #[inline]
     pub fn pair_apply(
@@ -52,26 +84,21 @@ impl Mobility {
         aj: f64,
         f: &Vector3<f64>,
     ) -> Vector3<f64> {
-        let r2 = r.norm_squared();
-        let inv_r = 1.0 / r2.sqrt();
-        let rhat_dot_f = r.dot(f) * inv_r * inv_r; // (r·F)/r², multiplies r (not r̂)
-        let c1 = inv_r / (8.0 * PI * mu);
-        let mut out = c1 * (f + r * rhat_dot_f);
-        if self == Mobility::Rpy {
-            let c3 = (ai * ai + aj * aj) * inv_r * inv_r * inv_r / (24.0 * PI * mu);
-            out += c3 * (f - r * (3.0 * rhat_dot_f));
+        let d = r.norm();
+        let (ci, crr) = self.pair_coefficients(mu, d, ai, aj);
+        if crr == 0.0 {
+            return ci * f;
         }
-        out
+        ci * f + r * (crr * r.dot(f) / (d * d))
     }
 
     /// The 3×3 block H_αβ (α ≠ β) as a matrix.
     pub fn pair_tensor(self, mu: f64, r: &Vector3<f64>, ai: f64, aj: f64) -> Matrix3<f64> {
         let d = r.norm();
-        let rr = r * r.transpose() / (d * d);
-        let id = Matrix3::identity();
-        let mut h = (id + rr) / (8.0 * PI * mu * d);
-        if self == Mobility::Rpy {
-            h += (ai * ai + aj * aj) / (24.0 * PI * mu * d * d * d) * (id - 3.0 * rr);
+        let (ci, crr) = self.pair_coefficients(mu, d, ai, aj);
+        let mut h = ci * Matrix3::identity();
+        if crr != 0.0 {
+            h += crr * r * r.transpose() / (d * d);
         }
         h
     }

@@ -7,6 +7,7 @@
 pub mod averaged;
 pub mod backend;
 pub mod build;
+pub mod contacts;
 pub mod error;
 pub mod gpu;
 pub mod integrators;
@@ -22,6 +23,7 @@ mod spheres;
 pub mod swimmer;
 
 pub use backend::Backend;
+pub use contacts::{Contacts, Steric};
 pub use error::{EngineError, Result};
 pub use integrators::IntegratorSpec;
 pub use mobility::Mobility;

@@ -37,7 +37,21 @@ pub enum Observable {
     Nematic,
     /// The smallest gap between the surfaces of any two spheres of the scene (m).
     MinGap,
+    /// Mean swimming speed ⟨|V|⟩ over the swimmers (m/s): V = dR_H/dt in the averaged model, the
+    /// displacement of R_H over the next period / T in the sphere models (a probe run on a copy).
+    MeanSpeed,
+    /// Histogram of the centre distances D_H of all pairs: `bins` counts, bin k covering
+    /// [k, k+1) · r_max/bins (m); pairs at r_max or beyond are not counted.
+    PairDistances {
+        /// Number of bins.
+        bins: usize,
+        /// Upper end of the last bin (m).
+        r_max: f64,
+    },
 }
+
+/// Most bins a pair-distance histogram may have (a recorder row holds one column per bin).
+pub const MAX_BINS: usize = 10_000;
 
 impl Observable {
     /// Short name, e.g. `R_H[0]`, `q[0,1]`.
@@ -57,6 +71,8 @@ impl Observable {
             Observable::Polarization => "polarization".into(),
             Observable::Nematic => "nematic".into(),
             Observable::MinGap => "min_gap".into(),
+            Observable::MeanSpeed => "mean_speed".into(),
+            Observable::PairDistances { .. } => "D_H_hist".into(),
         }
     }
 
@@ -71,6 +87,8 @@ impl Observable {
             | Observable::DistanceH(..)
             | Observable::MinGap => "m",
             Observable::Tension(_) => "N",
+            Observable::MeanSpeed => "m/s",
+            Observable::PairDistances { .. } => "pairs",
             Observable::DeltaDistanceH(..) => "ell",
             _ => "1",
         }
@@ -79,7 +97,9 @@ impl Observable {
     /// Column names of the components (`R_H[0].x`, … for vectors; the name for scalars).
     pub fn columns(&self) -> Vec<String> {
         let n = self.name();
-        if self.is_vector() {
+        if let Observable::PairDistances { bins, .. } = self {
+            (0..*bins).map(|k| format!("{n}[{k}]")).collect()
+        } else if self.is_vector() {
             ["x", "y", "z"].iter().map(|c| format!("{n}.{c}")).collect()
         } else {
             vec![n]
@@ -108,12 +128,23 @@ impl Observable {
             | Observable::DistanceH(i, j)
             | Observable::DeltaQ(i, j)
             | Observable::DeltaDistanceH(i, j) => vec![i, j],
-            Observable::Polarization | Observable::Nematic | Observable::MinGap => vec![],
+            Observable::Polarization
+            | Observable::Nematic
+            | Observable::MinGap
+            | Observable::MeanSpeed
+            | Observable::PairDistances { .. } => vec![],
         }
     }
 
-    /// Check that the indices exist in `scene`.
+    /// Check that the indices exist in `scene` and the parameters make sense.
     pub fn check(&self, scene: &Scene) -> Result<()> {
+        if let Observable::PairDistances { bins, r_max } = *self {
+            if bins == 0 || bins > MAX_BINS || !(r_max.is_finite() && r_max > 0.0) {
+                return Err(super::error::invalid!(
+                    "pair_distances(bins, r_max) needs 1 to {MAX_BINS} bins and a positive r_max in m, got {bins} and {r_max}; e.g. pair_distances(50, 100e-6)"
+                ));
+            }
+        }
         for i in self.indices() {
             scene.swimmer(i)?;
         }
@@ -175,6 +206,40 @@ impl Observable {
                 vec![SymmetricEigen::new(q).eigenvalues.max()]
             }
             Observable::MinGap => vec![Self::min_gap(s)],
+            Observable::MeanSpeed => {
+                let v = s.center_velocities()?;
+                vec![v.iter().map(|v| v.norm()).sum::<f64>() / v.len().max(1) as f64]
+            }
+            Observable::PairDistances { bins, r_max } => Self::histogram(s, bins, r_max)?,
+        })
+    }
+
+    /// Counts of pair distances D_H in `bins` bins on [0, r_max); rows in parallel for large scenes.
+    fn histogram(s: &Scene, bins: usize, r_max: f64) -> Result<Vec<f64>> {
+        use rayon::prelude::*;
+        let c = (0..s.count())
+            .map(|i| s.center(i))
+            .collect::<Result<Vec<_>>>()?;
+        let width = r_max / bins as f64;
+        let row = |i: usize| {
+            let mut h = vec![0.0; bins];
+            for cj in &c[i + 1..] {
+                let k = ((c[i] - cj).norm() / width) as usize;
+                if k < bins {
+                    h[k] += 1.0;
+                }
+            }
+            h
+        };
+        let add = |mut a: Vec<f64>, b: Vec<f64>| {
+            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+            a
+        };
+        // Counts are integers in f64: the sum is exact in any order.
+        Ok(if c.len() >= 256 {
+            (0..c.len()).into_par_iter().map(row).reduce(|| vec![0.0; bins], add)
+        } else {
+            (0..c.len()).map(row).fold(vec![0.0; bins], add)
         })
     }
 

@@ -30,6 +30,8 @@ pub struct SoaSpheres {
     pub y: Vec<f64>,
     /// z (m).
     pub z: Vec<f64>,
+    /// Radii (m).
+    pub a: Vec<f64>,
     /// Radii squared (m²).
     pub a2: Vec<f64>,
     /// Forces (N).
@@ -47,6 +49,7 @@ impl SoaSpheres {
             &mut self.x,
             &mut self.y,
             &mut self.z,
+            &mut self.a,
             &mut self.a2,
             &mut self.fx,
             &mut self.fy,
@@ -54,6 +57,12 @@ impl SoaSpheres {
         ] {
             v.resize(n, 0.0);
         }
+    }
+
+    /// Set sphere `i`'s radius (m) and its square.
+    pub fn set_radius(&mut self, i: usize, a: f64) {
+        self.a[i] = a;
+        self.a2[i] = a * a;
     }
 
     /// Number of spheres.
@@ -76,53 +85,105 @@ fn prefactors(m: Mobility, mu: f64) -> (f64, f64) {
     (1.0 / (8.0 * PI * mu), c3)
 }
 
+/// The kernel's constants: the mobility with μ, and its prefactors.
+#[derive(Clone, Copy)]
+struct Kernel {
+    m: Mobility,
+    mu: f64,
+    c1: f64,
+    c3: f64,
+}
+
 /// u_i for the rows `first..first + u.len()`, written to `u` as (ux, uy, uz).
+///
+/// Overlapping pairs (r < a_i + a_j, RPY only) are masked out of the vector loop, counted per
+/// lane, and added afterwards in a scalar pass with the overlapping-sphere form
+/// ([`Mobility::pair_apply`]); rows without overlaps (all of them in a scene that stops at
+/// contact) never take that pass.
 #[inline(always)]
-fn rows_impl(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
+fn rows_impl(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
+    let (c1, c3) = (k.c1, k.c3);
+    // Oseen has no finite size: nothing is masked.
+    let reach = if c3 != 0.0 { 1.0 } else { 0.0 };
     let n = s.len();
     let blocks = n / LANES;
-    for (k, out) in u.iter_mut().enumerate() {
-        let i = first + k;
-        let (xi, yi, zi, ai2) = (s.x[i], s.y[i], s.z[i], s.a2[i]);
+    for (row, out) in u.iter_mut().enumerate() {
+        let i = first + row;
+        let (xi, yi, zi, ai, ai2) = (s.x[i], s.y[i], s.z[i], s.a[i] * reach, s.a2[i]);
         let mut ax = [0.0; LANES];
         let mut ay = [0.0; LANES];
         let mut az = [0.0; LANES];
-        let term = |x: f64, y: f64, z: f64, a2: f64, fx: f64, fy: f64, fz: f64| {
+        let mut overlaps = [0.0; LANES];
+        let term = |x: f64, y: f64, z: f64, a: f64, a2: f64, fx: f64, fy: f64, fz: f64| {
             let (rx, ry, rz) = (xi - x, yi - y, zi - z);
             let r2 = rx * rx + ry * ry + rz * rz;
             let inv = 1.0 / r2.sqrt();
-            let inv_r = if r2 > 0.0 { inv } else { 0.0 };
+            let contact = ai + a * reach;
+            let separated = r2 > contact * contact;
+            let inv_r = if separated { inv } else { 0.0 };
+            let overlap = if separated || r2 == 0.0 { 0.0 } else { 1.0 };
             let inv_r2 = inv_r * inv_r;
             let rdf = (rx * fx + ry * fy + rz * fz) * inv_r2;
             let o = c1 * inv_r;
             let f3 = c3 * (ai2 + a2) * inv_r * inv_r2;
             let cf = o + f3;
             let cr = (o - 3.0 * f3) * rdf;
-            (cf * fx + cr * rx, cf * fy + cr * ry, cf * fz + cr * rz)
+            (
+                cf * fx + cr * rx,
+                cf * fy + cr * ry,
+                cf * fz + cr * rz,
+                overlap,
+            )
         };
         for b in 0..blocks {
             let o = b * LANES;
             let x: &[f64; LANES] = s.x[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             let y: &[f64; LANES] = s.y[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             let z: &[f64; LANES] = s.z[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
+            let a: &[f64; LANES] = s.a[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             let a2: &[f64; LANES] = s.a2[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             let fx: &[f64; LANES] = s.fx[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             let fy: &[f64; LANES] = s.fy[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             let fz: &[f64; LANES] = s.fz[o..o + LANES].try_into().unwrap_or(&[0.0; LANES]);
             for l in 0..LANES {
-                let (tx, ty, tz) = term(x[l], y[l], z[l], a2[l], fx[l], fy[l], fz[l]);
+                let (tx, ty, tz, ov) = term(x[l], y[l], z[l], a[l], a2[l], fx[l], fy[l], fz[l]);
                 ax[l] += tx;
                 ay[l] += ty;
                 az[l] += tz;
+                overlaps[l] += ov;
             }
         }
         for j in blocks * LANES..n {
-            let (tx, ty, tz) = term(s.x[j], s.y[j], s.z[j], s.a2[j], s.fx[j], s.fy[j], s.fz[j]);
+            let (tx, ty, tz, ov) = term(
+                s.x[j], s.y[j], s.z[j], s.a[j], s.a2[j], s.fx[j], s.fy[j], s.fz[j],
+            );
             ax[0] += tx;
             ay[0] += ty;
             az[0] += tz;
+            overlaps[0] += ov;
         }
         *out = [lane_sum(&ax), lane_sum(&ay), lane_sum(&az)];
+        if lane_sum(&overlaps) > 0.0 {
+            add_overlapping(s, k, i, out);
+        }
+    }
+}
+
+/// Adds the terms of the spheres overlapping sphere `i` (skipped by the vector loop) to `out`.
+#[cold]
+fn add_overlapping(s: &SoaSpheres, k: Kernel, i: usize, out: &mut [f64; 3]) {
+    let xi = nalgebra::Vector3::new(s.x[i], s.y[i], s.z[i]);
+    for j in 0..s.len() {
+        let r = xi - nalgebra::Vector3::new(s.x[j], s.y[j], s.z[j]);
+        let r2 = r.norm_squared();
+        let contact = s.a[i] + s.a[j];
+        if j != i && r2 > 0.0 && r2 <= contact * contact {
+            let f = nalgebra::Vector3::new(s.fx[j], s.fy[j], s.fz[j]);
+            let v = k.m.pair_apply(k.mu, &r, s.a[i], s.a[j], &f);
+            out[0] += v.x;
+            out[1] += v.y;
+            out[2] += v.z;
+        }
     }
 }
 
@@ -134,14 +195,14 @@ fn lane_sum(a: &[f64; LANES]) -> f64 {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn rows_avx512(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
-    rows_impl(s, c1, c3, first, u)
+unsafe fn rows_avx512(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
+    rows_impl(s, k, first, u)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn rows_avx2(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
-    rows_impl(s, c1, c3, first, u)
+unsafe fn rows_avx2(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
+    rows_impl(s, k, first, u)
 }
 
 /// The widest vector unit this CPU has, for the report.
@@ -158,19 +219,19 @@ pub fn vector_unit() -> &'static str {
     "baseline"
 }
 
-fn rows(s: &SoaSpheres, c1: f64, c3: f64, first: usize, u: &mut [[f64; 3]]) {
+fn rows(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { rows_avx512(s, c1, c3, first, u) };
+            return unsafe { rows_avx512(s, k, first, u) };
         }
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { rows_avx2(s, c1, c3, first, u) };
+            return unsafe { rows_avx2(s, k, first, u) };
         }
     }
-    rows_impl(s, c1, c3, first, u)
+    rows_impl(s, k, first, u)
 }
 
 /// u_i = Σ_{j≠i} H_ij F_j for every sphere, rows in parallel (on rayon's pool) when `parallel`.
@@ -182,12 +243,13 @@ pub fn interaction_velocities(
     parallel: bool,
 ) {
     let (c1, c3) = prefactors(m, mu);
+    let k = Kernel { m, mu, c1, c3 };
     if parallel {
         u.par_chunks_mut(ROWS_PER_TASK)
             .enumerate()
-            .for_each(|(c, chunk)| rows(s, c1, c3, c * ROWS_PER_TASK, chunk));
+            .for_each(|(c, chunk)| rows(s, k, c * ROWS_PER_TASK, chunk));
     } else {
-        rows(s, c1, c3, 0, u);
+        rows(s, k, 0, u);
     }
 }
 

@@ -10,6 +10,7 @@
 //! and dN/dt = (I − NNᵀ)(u₂ − u₁)/L, u the interaction velocities. Nothing is stiff any more: the
 //! step is set by the stroke, not by the spring.
 
+use super::contacts::Contacts;
 use super::integrators::{OdeSystem, Problem};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
@@ -29,12 +30,25 @@ pub struct RigidSystem {
 
 impl RigidSystem {
     /// A system for these swimmers, base positions, viscosity and mobility.
-    pub fn new(swimmers: &[Dumbbell], base: &[Vector3<f64>], mu: f64, mobility: Mobility) -> Self {
+    ///
+    /// `allow_overlap` lets spheres of different swimmers overlap (see [`Contacts`]); the steric
+    /// repulsion has no place here, since the constraint solve takes dumbbell tensions only.
+    pub fn new(
+        swimmers: &[Dumbbell],
+        base: &[Vector3<f64>],
+        mu: f64,
+        mobility: Mobility,
+        allow_overlap: bool,
+    ) -> Self {
         let s = swimmers.len();
+        let contacts = Contacts {
+            allow_overlap,
+            steric: None,
+        };
         RigidSystem {
             swimmers: swimmers.to_vec(),
             base: base.to_vec(),
-            spheres: Spheres::new(swimmers, mu, mobility),
+            spheres: Spheres::new(swimmers, mu, mobility, contacts),
             a: DMatrix::zeros(s, s),
             rate: DVector::zeros(s),
         }

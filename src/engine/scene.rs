@@ -3,6 +3,7 @@
 
 use super::averaged::AveragedSystem;
 use super::backend::{self, Backend};
+use super::contacts::{Contacts, Steric};
 use super::error::{invalid, require_finite, require_positive, EngineError, Result};
 use super::gpu::{GpuModel, GpuRun, RunOutcome, UniformSteps};
 use super::integrators::{uniform_steps, IntegratorSpec, OdeSystem, Stats, Stepper};
@@ -51,6 +52,12 @@ pub struct Scene {
     model: Model,
     mobility: Mobility,
     coefficients: Coefficients,
+    /// Overlaps and steric repulsion between swimmers (saved; defaults for older files).
+    #[serde(default)]
+    contacts: Contacts,
+    /// Far-field cutoff of the averaged model's pair sums (m); `None`: every pair.
+    #[serde(default)]
+    cutoff: Option<f64>,
     /// `None`: the model's default.
     integrator: Option<IntegratorSpec>,
     swimmers: Vec<Dumbbell>,
@@ -80,6 +87,8 @@ impl Default for Scene {
             model: Model::default(),
             mobility: Mobility::default(),
             coefficients: Coefficients::default(),
+            contacts: Contacts::default(),
+            cutoff: None,
             integrator: None,
             swimmers: Vec::new(),
             base: Vec::new(),
@@ -102,6 +111,8 @@ impl Clone for Scene {
             model: self.model,
             mobility: self.mobility,
             coefficients: self.coefficients,
+            contacts: self.contacts,
+            cutoff: self.cutoff,
             integrator: self.integrator,
             swimmers: self.swimmers.clone(),
             base: self.base.clone(),
@@ -239,6 +250,40 @@ impl Scene {
         self.coefficients = c;
     }
 
+    /// Contact handling: overlaps between swimmers and steric repulsion.
+    pub fn contacts(&self) -> Contacts {
+        self.contacts
+    }
+
+    /// Let spheres of different swimmers overlap (RPY's overlapping form) instead of stopping.
+    pub fn set_allow_overlap(&mut self, allow: bool) {
+        self.contacts.allow_overlap = allow;
+    }
+
+    /// Switch the steric repulsion between swimmers on (`Some`) or off.
+    pub fn set_steric(&mut self, steric: Option<Steric>) {
+        self.contacts.steric = steric;
+    }
+
+    /// The averaged model's far-field cutoff (m), if any.
+    pub fn cutoff(&self) -> Option<f64> {
+        self.cutoff
+    }
+
+    /// Leave pairs further apart than `cutoff` (m) out of the averaged model's sums; `None`: keep
+    /// every pair (the default). The error this makes is bounded in [`AveragedSystem`].
+    pub fn set_cutoff(&mut self, cutoff: Option<f64>) -> Result<()> {
+        if let Some(c) = cutoff {
+            if !(c.is_finite() && c > 0.0) {
+                return Err(invalid!(
+                    "the cutoff must be a positive distance in m, got {c}; e.g. s.cutoff = 20 * 10e-6, or s.cutoff = () for every pair"
+                ));
+            }
+        }
+        self.cutoff = cutoff;
+        Ok(())
+    }
+
     /// The integrator in use (the model's default for this scene unless one was set).
     pub fn integrator(&self) -> IntegratorSpec {
         self.integrator.unwrap_or_else(|| self.default_integrator())
@@ -297,9 +342,22 @@ impl Scene {
             .map(|(gpu, why)| format!("{}: {why}", if gpu { "gpu" } else { "cpu" }))
     }
 
+    /// The options the device kernels do not have: contact handling and the cutoff.
+    fn gpu_options_supported(&self) -> std::result::Result<(), String> {
+        let cpu_only = |what: &str| Err(format!("{what} runs on the CPU only"));
+        match self.model {
+            Model::Micro | Model::Rigid if self.contacts != Contacts::default() => {
+                cpu_only("contact handling (s.overlaps = \"allow\", s.steric)")
+            }
+            Model::Averaged if self.cutoff.is_some() => cpu_only("the far-field cutoff (s.cutoff)"),
+            _ => Ok(()),
+        }
+    }
+
     /// Whether the next run takes the GPU, and why.
     fn plan(&self) -> Result<(bool, String)> {
         let fit = backend::gpu_model_supported(self.model)
+            .and_then(|()| self.gpu_options_supported())
             .and_then(|()| backend::gpu_tableau(&self.integrator()).map(|_| ()));
         match self.backend {
             Backend::Cpu => Ok((false, "s.backend = \"cpu\"".into())),
@@ -529,7 +587,13 @@ impl Scene {
                 Ok(d.k0 * (self.length(i)? - d.rest_length(self.time)))
             }
             Model::Rigid => {
-                let mut sys = RigidSystem::new(&self.swimmers, &self.base, self.mu, self.mobility);
+                let mut sys = RigidSystem::new(
+                    &self.swimmers,
+                    &self.base,
+                    self.mu,
+                    self.mobility,
+                    self.contacts.allow_overlap,
+                );
                 Ok(sys.tensions(self.time, &self.state)[i])
             }
             Model::Averaged => Err(invalid!(
@@ -558,6 +622,25 @@ impl Scene {
         Ok((v, spin))
     }
 
+    /// Every swimmer's swimming velocity (m/s): dR_H/dt of the averaged model; in the sphere models,
+    /// whose centres oscillate within a stroke, R_H's displacement over the next period divided
+    /// by T (measured on a copy; the scene is not changed).
+    pub fn center_velocities(&self) -> Result<Vec<Vector3<f64>>> {
+        let n = self.count();
+        if self.model == Model::Averaged {
+            let mut sys = self.system()?;
+            let mut dy = vec![0.0; self.state.len()];
+            sys.rhs(self.time, &self.state, &mut dy);
+            return Ok((0..n).map(|i| vec3(&dy, STATE_PER_SWIMMER * i)).collect());
+        }
+        let period = self.period()?;
+        let mut probe = self.clone();
+        probe.run_periods(1.0, &never)?;
+        (0..n)
+            .map(|i| Ok((probe.displacement(i)? - self.displacement(i)?) / period))
+            .collect()
+    }
+
     /// The state vector (see [`super::model`]) and the base positions: for tests and savers.
     pub fn raw_state(&self) -> (&[f64], &[Vector3<f64>]) {
         (&self.state, &self.base)
@@ -570,21 +653,32 @@ impl Scene {
                 &self.base,
                 self.mu,
                 self.mobility,
+                self.contacts,
             )),
-            Model::Rigid => Box::new(RigidSystem::new(
-                &self.swimmers,
-                &self.base,
-                self.mu,
-                self.mobility,
-            )),
+            Model::Rigid => {
+                if self.contacts.steric.is_some() {
+                    return Err(invalid!(
+                        "steric repulsion needs the microscopic model (the rigid-stroke solve takes dumbbell tensions only); set s.model = \"micro\" or s.steric = ()"
+                    ));
+                }
+                Box::new(RigidSystem::new(
+                    &self.swimmers,
+                    &self.base,
+                    self.mu,
+                    self.mobility,
+                    self.contacts.allow_overlap,
+                ))
+            }
             Model::Averaged => {
                 self.check_averaged()?;
-                Box::new(AveragedSystem::new(
+                let mut sys = AveragedSystem::new(
                     &self.swimmers,
                     &self.base,
                     self.coefficients,
                     &self.state,
-                ))
+                );
+                sys.set_cutoff(self.cutoff);
+                Box::new(sys)
             }
         })
     }

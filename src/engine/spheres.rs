@@ -2,8 +2,9 @@
 //! them: radii, positions, the force on each, and the interaction velocities the mobility gives.
 //! Sphere 2σ is dumbbell σ's a1 sphere, 2σ+1 its a2 sphere.
 
+use super::contacts::Contacts;
 use super::integrators::Problem;
-use super::mobility::Mobility;
+use super::mobility::{self_mobility, Mobility};
 use super::pairs::{self, SoaSpheres};
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
@@ -16,7 +17,13 @@ pub(crate) struct Spheres {
     pub(crate) radii: Vec<f64>,
     /// Positions (m), filled by the model before [`Spheres::interact`].
     pub(crate) pos: Vec<Vector3<f64>>,
+    /// Force on every sphere: ±spring (or tension) plus steric forces.
     forces: Vec<Vector3<f64>>,
+    /// The dumbbell force f(σ) on sphere 1 of each dumbbell.
+    spring: Vec<Vector3<f64>>,
+    /// Steric force on every sphere (empty when the repulsion is off).
+    steric: Vec<Vector3<f64>>,
+    contacts: Contacts,
     u: Vec<Vector3<f64>>,
     /// Scratch of the fast kernel (large scenes).
     soa: SoaSpheres,
@@ -32,7 +39,12 @@ pub const PARALLEL_SPHERES: usize = 256;
 
 impl Spheres {
     /// Spheres of these dumbbells in a fluid of viscosity `mu`.
-    pub(crate) fn new(swimmers: &[Dumbbell], mu: f64, mobility: Mobility) -> Self {
+    pub(crate) fn new(
+        swimmers: &[Dumbbell],
+        mu: f64,
+        mobility: Mobility,
+        contacts: Contacts,
+    ) -> Self {
         let n = 2 * swimmers.len();
         Spheres {
             mu,
@@ -40,6 +52,12 @@ impl Spheres {
             radii: swimmers.iter().flat_map(|d| [d.a1, d.a2]).collect(),
             pos: vec![Vector3::zeros(); n],
             forces: vec![Vector3::zeros(); n],
+            spring: vec![Vector3::zeros(); swimmers.len()],
+            steric: match contacts.steric {
+                Some(_) => vec![Vector3::zeros(); n],
+                None => Vec::new(),
+            },
+            contacts,
             u: vec![Vector3::zeros(); n],
             soa: SoaSpheres::default(),
             soa_u: Vec::new(),
@@ -48,13 +66,33 @@ impl Spheres {
 
     /// Put force `f(σ)` on sphere 1 and −f(σ) on sphere 2 of every dumbbell (each dumbbell is
     /// force-free) and compute the interaction velocities u_α = Σ_{β≠α} H_αβ F_β.
+    ///
+    /// With steric repulsion on, its forces F^s join the others and u_α also carries their own
+    /// drag F^s_α/(6πμa_α) (they are not force-free per dumbbell, so that part does not cancel).
     #[inline]
     pub(crate) fn interact(&mut self, f: impl Fn(usize) -> Vector3<f64>) {
         for s in 0..self.radii.len() / 2 {
             let fs = f(s);
+            self.spring[s] = fs;
             self.forces[2 * s] = fs;
             self.forces[2 * s + 1] = -fs;
         }
+        let n = self.pos.len();
+        if let Some(st) = self.contacts.steric {
+            self.steric.fill(Vector3::zeros());
+            st.add_forces(&self.pos, &self.radii, &mut self.steric, n >= PARALLEL_SPHERES);
+            for (f, s) in self.forces.iter_mut().zip(&self.steric) {
+                *f += s;
+            }
+        }
+        self.pair_velocities();
+        for ((u, s), a) in self.u.iter_mut().zip(&self.steric).zip(&self.radii) {
+            *u += s * self_mobility(self.mu, *a);
+        }
+    }
+
+    /// u_α = Σ_{β≠α} H_αβ F_β for the forces set.
+    fn pair_velocities(&mut self) {
         let n = self.pos.len();
         if n < FAST_KERNEL_SPHERES {
             self.mobility.interaction_velocities(
@@ -88,7 +126,7 @@ impl Spheres {
             s.x[i] = p.x;
             s.y[i] = p.y;
             s.z[i] = p.z;
-            s.a2[i] = self.radii[i] * self.radii[i];
+            s.set_radius(i, self.radii[i]);
             s.fx[i] = f.x;
             s.fy[i] = f.y;
             s.fz[i] = f.z;
@@ -105,7 +143,7 @@ impl Spheres {
     /// The force on sphere 1 of dumbbell `s` set by the last [`Spheres::interact`].
     #[inline]
     pub(crate) fn force(&self, s: usize) -> Vector3<f64> {
-        self.forces[2 * s]
+        self.spring[s]
     }
 
     /// dR_H/dt of dumbbell `s` = (a1 u₁ + a2 u₂)/(a1+a2): the drag parts cancel exactly (the
@@ -122,8 +160,16 @@ impl Spheres {
     }
 
     /// The first pair of overlapping spheres at the current positions, as a problem naming the
-    /// swimmers.
+    /// swimmers; with overlaps between swimmers allowed, only a dumbbell's own spheres count.
     pub(crate) fn first_overlap(&mut self) -> Option<Problem> {
+        if self.contacts.allow_overlap {
+            return (0..self.pos.len() / 2).find_map(|s| {
+                let gap = (self.pos[2 * s] - self.pos[2 * s + 1]).norm()
+                    - self.radii[2 * s]
+                    - self.radii[2 * s + 1];
+                (gap <= 0.0).then(|| overlap_problem(gap, 2 * s, 2 * s + 1))
+            });
+        }
         if self.pos.len() >= FAST_KERNEL_SPHERES {
             return match self.min_gap() {
                 Some((gap, a, b)) if gap <= 0.0 => Some(overlap_problem(gap, a, b)),
@@ -159,6 +205,10 @@ fn overlap_problem(gap: f64, a: usize, b: usize) -> Problem {
     Problem {
         swimmer: Some(sa),
         cause,
-        hint: "start the swimmers further apart, or use a smaller time step if the overlap came from a step that was too large".into(),
+        hint: if sa == sb {
+            "use a smaller time step (an explicit step above its stability limit collapses the spring), or a shorter stroke".into()
+        } else {
+            "start the swimmers further apart or take a smaller time step; or let swimmers overlap (s.overlaps = \"allow\") or repel each other (s.steric = #{ range: 1e-7, stiffness: 1e-3 })".into()
+        },
     }
 }

@@ -146,6 +146,17 @@ pub fn register(engine: &mut Engine) {
         .register_fn("polarization", || Observable::Polarization)
         .register_fn("min_gap", || Observable::MinGap)
         .register_fn("nematic", || Observable::Nematic)
+        .register_fn("mean_speed", || Observable::MeanSpeed)
+        .register_fn(
+            "pair_distances",
+            |bins: INT, r_max: Dynamic| -> ScriptResult<Observable> {
+                let o = Observable::PairDistances {
+                    bins: usize::try_from(bins).unwrap_or(0),
+                    r_max: number("pair_distances(bins, r_max): r_max", &r_max)?,
+                };
+                lift(o.check(&crate::engine::Scene::default())).map(|_| o)
+            },
+        )
         .register_fn(
             "observe",
             |s: &mut SceneHandle, o: Observable| -> ScriptResult<Dynamic> {

@@ -6,7 +6,7 @@
 use super::convert::{array3, index, lift, number, script_error, unknown_choice, ScriptResult};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
-use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene};
+use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric};
 use rhai::{Array, Dynamic, Engine, ImmutableString, INT};
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -38,6 +38,29 @@ fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {
         .into_immutable_string()
         .map(|s| s.to_string())
         .map_err(|t| script_error(format!("{what} must be a string, got {v} ({t})")))
+}
+
+/// `s.steric = #{ range, stiffness }` (m, N/m) or `()` for none.
+fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
+    const FIX: &str = "use s.steric = #{ range: 1e-7, stiffness: 1e-3 } (m, N/m), or s.steric = () for none";
+    if v.is_unit() {
+        return Ok(None);
+    }
+    let Some(map) = v.clone().try_cast::<rhai::Map>() else {
+        return Err(script_error(format!("s.steric must be a map or (), got {v}; {FIX}")));
+    };
+    let (mut range, mut stiffness) = (None, None);
+    for (k, val) in &map {
+        match k.as_str() {
+            "range" => range = Some(number("steric range", val)?),
+            "stiffness" => stiffness = Some(number("steric stiffness", val)?),
+            other => return Err(script_error(format!("s.steric: unknown key \"{other}\"; {FIX}"))),
+        }
+    }
+    match (range, stiffness) {
+        (Some(r), Some(k)) => lift(Steric::new(r, k)).map(Some),
+        _ => Err(script_error(format!("s.steric needs both range and stiffness; {FIX}"))),
+    }
 }
 
 fn swimmer_index(v: &Dynamic) -> ScriptResult<usize> {
@@ -233,6 +256,42 @@ pub fn register(engine: &mut Engine) {
                 Ok(())
             },
         )
+        .register_get("overlaps", |s: &mut SceneHandle| {
+            ImmutableString::from(if s.0.borrow().contacts().allow_overlap { "allow" } else { "stop" })
+        })
+        .register_set(
+            "overlaps",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let name = string_arg("overlaps", &v)?;
+                let allow = match name.as_str() {
+                    "stop" => false,
+                    "allow" => true,
+                    _ => return Err(unknown_choice("overlaps setting", &name, &["stop", "allow"])),
+                };
+                s.0.borrow_mut().set_allow_overlap(allow);
+                Ok(())
+            },
+        )
+        .register_get("steric", |s: &mut SceneHandle| match s.0.borrow().contacts().steric {
+            Some(st) => {
+                let mut m = rhai::Map::new();
+                m.insert("range".into(), Dynamic::from_float(st.range));
+                m.insert("stiffness".into(), Dynamic::from_float(st.stiffness));
+                Dynamic::from_map(m)
+            }
+            None => Dynamic::UNIT,
+        })
+        .register_set("steric", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+            s.0.borrow_mut().set_steric(steric_arg(&v)?);
+            Ok(())
+        })
+        .register_get("cutoff", |s: &mut SceneHandle| {
+            s.0.borrow().cutoff().map_or(Dynamic::UNIT, Dynamic::from_float)
+        })
+        .register_set("cutoff", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+            let c = if v.is_unit() { None } else { Some(number("s.cutoff", &v)?) };
+            s.with_mut(|sc| sc.set_cutoff(c))
+        })
         .register_get("integrator", |s: &mut SceneHandle| s.0.borrow().integrator())
         .register_set(
             "integrator",
