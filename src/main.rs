@@ -64,10 +64,13 @@ enum BenchKind {
     /// The CPU pair kernel: RPY interactions per second at N = 4,096 spheres, serial and on 1 …
     /// all cores, against the ~1e9 per core bound.
     Pairs,
+    /// Cost per stroke period against the number of swimmers (2 … 4,096; --quick: up to 256),
+    /// microscopic and averaged models on the CPU, with fitted power-law exponents.
+    Scaling,
 }
 
 fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
-    use swimlab::bench::{backends, pairs, stability, work_precision};
+    use swimlab::bench::{backends, pairs, scaling, stability, work_precision};
     use swimlab::engine::Model;
     let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
     match which {
@@ -116,6 +119,28 @@ fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
             t.write_csv(std::path::Path::new("out/bench/pairs.csv"))
                 .map_err(io)?;
             println!("\nCSV written to out/bench/pairs.csv");
+        }
+        BenchKind::Scaling => {
+            let rows = scaling::run(if quick { 256 } else { 4096 })?;
+            let t = scaling::table(&rows);
+            println!(
+                "cost per stroke period on the CPU ({} threads; lattice scenes, RK4: micro at its default step, averaged one step per period):\n{}",
+                rayon::current_num_threads(),
+                t.render()
+            );
+            for m in [Model::Micro, Model::Averaged] {
+                for from in [2, 256] {
+                    if let Some((k, c)) = scaling::fit(&rows, m, from) {
+                        println!(
+                            "{}: cost per period ~ {c:.2e} s * S^{k:.2} (fit over S >= {from})",
+                            m.name()
+                        );
+                    }
+                }
+            }
+            t.write_csv(std::path::Path::new("out/bench/scaling.csv"))
+                .map_err(io)?;
+            println!("\nCSV written to out/bench/scaling.csv");
         }
         BenchKind::Backends => {
             match swimlab::engine::gpu::device() {

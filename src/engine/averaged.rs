@@ -10,7 +10,9 @@
 //! What a scene does not need is skipped: pairs with sin(φσ−φρ) = 0, the I and K terms of symmetric
 //! swimmers, and for an aligned scene the 3D algebra (the 1D reduction e:stroke_averaged).
 
+use super::contacts::{Contacts, Steric};
 use super::integrators::{OdeSystem, Problem};
+use super::mobility::self_mobility;
 use super::model::{set_vec3, vec3, Coefficients, STATE_PER_SWIMMER};
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
@@ -146,6 +148,10 @@ pub struct AveragedSystem {
     scale_r: Vec<f64>,
     scale_n: Vec<f64>,
     skip_symmetric: bool,
+    /// Radii (a1, a2) and the weights (w1, w2) placing the spheres about R_H.
+    spheres: Vec<[f64; 4]>,
+    contacts: Contacts,
+    mu: f64,
 }
 
 impl AveragedSystem {
@@ -192,11 +198,82 @@ impl AveragedSystem {
             cutoff2: f64::INFINITY,
             axis: None,
             skip_symmetric: shortcuts.skip_symmetric_terms,
+            spheres: swimmers
+                .iter()
+                .map(|d| [d.a1, d.a2, d.w1(), d.w2()])
+                .collect(),
+            contacts: Contacts::default(),
+            mu: super::scene::DEFAULT_MU,
         };
         if shortcuts.aligned_1d {
             sys.axis = sys.common_axis(y);
         }
         sys
+    }
+
+    /// Contact handling in fluid of viscosity `mu`. The averaged model knows no sphere positions;
+    /// for contacts its swimmers are rigid dumbbells of length ℓ, spheres at R_H − w2 ℓN and
+    /// R_H + w1 ℓN. By default the run stops when spheres of two swimmers overlap (the far-field
+    /// terms grow as D⁻⁵ there, the model has left its range). Steric forces F₁, F₂ on a swimmer's
+    /// spheres move it as a free-draining rigid dumbbell: dR_H/dt += (F₁ + F₂)/(6πμ(a1 + a2)),
+    /// dN/dt += (1 − NNᵀ)(F₂/(6πμa2) − F₁/(6πμa1))/ℓ (the rod's tension drops out).
+    pub fn set_contacts(&mut self, contacts: Contacts, mu: f64) {
+        self.contacts = contacts;
+        self.mu = mu;
+        if contacts.steric.is_some() {
+            // The 1D reduction has no sphere geometry.
+            self.axis = None;
+        }
+    }
+
+    /// The two sphere centres of swimmer σ (length ℓ), from the arrays.
+    #[inline]
+    fn sphere_centres(&self, s: usize) -> [Vector3<f64>; 2] {
+        let soa = &self.soa;
+        let c = Vector3::new(soa.x[s], soa.y[s], soa.z[s]);
+        let b = Vector3::new(soa.nx[s], soa.ny[s], soa.nz[s]) * self.coef[s].ell;
+        let [_, _, w1, w2] = self.spheres[s];
+        [c - w2 * b, c + w1 * b]
+    }
+
+    /// The smallest surface gap between a sphere of σ and one of ρ, with the spheres (k, m).
+    fn closest_spheres(&self, s: usize, r: usize) -> (f64, usize, usize) {
+        let (ps, pr) = (self.sphere_centres(s), self.sphere_centres(r));
+        let mut best = (f64::INFINITY, 0, 0);
+        for k in 0..2 {
+            for m in 0..2 {
+                let gap = (ps[k] - pr[m]).norm() - self.spheres[s][k] - self.spheres[r][m];
+                if gap < best.0 {
+                    best = (gap, k, m);
+                }
+            }
+        }
+        best
+    }
+
+    /// The steric rates (dR_H/dt, dN/dt) of swimmer σ.
+    fn steric_rates(&self, st: &Steric, s: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let ps = self.sphere_centres(s);
+        let mut f = [Vector3::zeros(); 2];
+        for r in (0..self.coef.len()).filter(|&r| r != s) {
+            let pr = self.sphere_centres(r);
+            for k in 0..2 {
+                for m in 0..2 {
+                    let d = ps[k] - pr[m];
+                    let dist = d.norm();
+                    let gap = dist - self.spheres[s][k] - self.spheres[r][m];
+                    if gap < st.range && dist > 0.0 {
+                        f[k] += d * (st.stiffness * (st.range - gap) / dist);
+                    }
+                }
+            }
+        }
+        let [a1, a2, _, _] = self.spheres[s];
+        let v = (f[0] + f[1]) * self_mobility(self.mu, a1 + a2);
+        let rel = (f[1] * self_mobility(self.mu, a2) - f[0] * self_mobility(self.mu, a1))
+            / self.coef[s].ell;
+        let n = Vector3::new(self.soa.nx[s], self.soa.ny[s], self.soa.nz[s]);
+        (v, rel - n * n.dot(&rel))
     }
 
     /// Leave out pairs further apart than `cutoff` (m); `None` keeps every pair.
@@ -350,9 +427,14 @@ impl AveragedSystem {
                 out[3..6].fill(0.0);
                 return;
             }
-            let (v, t) = self.row(s);
+            let (mut v, t) = self.row(s);
             let n = vec3(y, STATE_PER_SWIMMER * s + 3);
-            let dn = -(t - n * n.dot(&t));
+            let mut dn = -(t - n * n.dot(&t));
+            if let Some(st) = &self.contacts.steric {
+                let (vs, ns) = self.steric_rates(st, s);
+                v += vs;
+                dn += ns;
+            }
             out[..3].copy_from_slice(v.as_slice());
             out[3..6].copy_from_slice(dn.as_slice());
         };
@@ -401,14 +483,25 @@ impl OdeSystem for AveragedSystem {
         self.fill(y);
         let soa = &self.soa;
         let n = self.coef.len();
+        let guard = !self.contacts.allow_overlap;
+        // The first problem of row σ: a shared centre, or (unless allowed) touching spheres.
         let row = |s: usize| {
-            (s + 1..n).find(|&r| {
-                self.pair_sin(s, r).is_some()
-                    && soa.x[s] == soa.x[r]
-                    && soa.y[s] == soa.y[r]
-                    && soa.z[s] == soa.z[r]
+            (s + 1..n).find_map(|r| {
+                if soa.x[s] == soa.x[r] && soa.y[s] == soa.y[r] && soa.z[s] == soa.z[r] {
+                    return self.pair_sin(s, r).is_some().then(|| Problem {
+                        swimmer: Some(s),
+                        cause: format!("swimmers {s} and {r} have the same centre"),
+                        hint: "start the swimmers apart: the averaged model is a far-field model"
+                            .into(),
+                    });
+                }
+                if !guard {
+                    return None;
+                }
+                let (gap, k, m) = self.closest_spheres(s, r);
+                (gap <= 0.0)
+                    .then(|| super::spheres::overlap_problem(gap, 2 * s + k, 2 * r + m))
             })
-            .map(|r| (s, r))
         };
         let found = if n >= PARALLEL_SWIMMERS {
             (0..n).into_par_iter().find_map_first(row)
@@ -416,11 +509,7 @@ impl OdeSystem for AveragedSystem {
             (0..n).find_map(row)
         };
         match found {
-            Some((s, r)) => Err(Problem {
-                swimmer: Some(s),
-                cause: format!("swimmers {s} and {r} have the same centre"),
-                hint: "start the swimmers apart: the averaged model is a far-field model".into(),
-            }),
+            Some(p) => Err(p),
             None => Ok(()),
         }
     }

@@ -71,7 +71,7 @@ pub fn box_side(n: usize, d: &Dumbbell, phi: f64) -> Result<f64> {
 }
 
 /// `n` copies of `d` placed uniformly at random in a cube of side `side` (m) centred on the
-/// origin, without overlapping spheres, with the given orientations and phases: random sequential
+/// origin, every sphere gap wider than the strokes can close, with the given orientations and phases: random sequential
 /// addition from the generator seeded with `seed`.
 pub fn random_suspension(
     scene: &mut Scene,
@@ -83,6 +83,9 @@ pub fn random_suspension(
     seed: u64,
 ) -> Result<()> {
     require_positive("box side", side, "m")?;
+    // Over a stroke a sphere moves by w·2λ along its axis (w = a_other/(a1+a2)): two spheres
+    // placed further apart than 4λ·max(w1, w2) cannot be brought into contact by the strokes.
+    let margin = 4.0 * d.lambda * d.w1().max(d.w2());
     let mut rng = Rng::new(seed);
     let max_tries = 1000 * (n + 1);
     let mut tries = 0;
@@ -103,7 +106,7 @@ pub fn random_suspension(
             Phases::Random => 2.0 * PI * rng.uniform(),
             Phases::Equal(p) => p,
         };
-        if scene.fits(&Dumbbell { phase, ..d }, c, dir) {
+        if scene.fits(&Dumbbell { phase, ..d }, c, dir, margin) {
             scene.add(Dumbbell { phase, ..d }, c, dir)?;
             placed += 1;
         }

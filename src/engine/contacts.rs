@@ -8,7 +8,8 @@
 //! collapsed). The steric repulsion is a soft harmonic wall between spheres of different
 //! swimmers: F = k (δ − gap) r̂ for gap < δ, zero beyond, pushing the spheres apart; it is a
 //! pair force (momentum is conserved) and costs an O(N²) pass per right-hand side, paid only
-//! when it is on.
+//! when it is on. The averaged model places its swimmers' spheres at length ℓ for both (see
+//! [`super::averaged::AveragedSystem::set_contacts`]).
 
 use super::error::{invalid, Result};
 use nalgebra::Vector3;
@@ -20,7 +21,7 @@ use serde::{Deserialize, Serialize};
 pub struct Contacts {
     /// Let spheres of different swimmers overlap instead of stopping the run.
     pub allow_overlap: bool,
-    /// Steric repulsion between spheres of different swimmers (microscopic model).
+    /// Steric repulsion between spheres of different swimmers (microscopic and averaged models).
     pub steric: Option<Steric>,
 }
 

@@ -96,8 +96,8 @@ struct Kernel {
 
 /// u_i for the rows `first..first + u.len()`, written to `u` as (ux, uy, uz).
 ///
-/// Overlapping pairs (r < a_i + a_j, RPY only) are masked out of the vector loop, counted per
-/// lane, and added afterwards in a scalar pass with the overlapping-sphere form
+/// Overlapping pairs (r ≤ a_i + a_j, RPY only; coincident spheres included) are masked out of
+/// the vector loop, counted per lane, and added afterwards in a scalar pass with the overlapping-sphere form
 /// ([`Mobility::pair_apply`]); rows without overlaps (all of them in a scene that stops at
 /// contact) never take that pass.
 #[inline(always)]
@@ -121,7 +121,8 @@ fn rows_impl(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
             let contact = ai + a * reach;
             let separated = r2 > contact * contact;
             let inv_r = if separated { inv } else { 0.0 };
-            let overlap = if separated || r2 == 0.0 { 0.0 } else { 1.0 };
+            // Counts the row's own sphere too (r² = 0), so a row overlaps from a count of 2.
+            let overlap = if separated { 0.0 } else { 1.0 };
             let inv_r2 = inv_r * inv_r;
             let rdf = (rx * fx + ry * fy + rz * fz) * inv_r2;
             let o = c1 * inv_r;
@@ -163,7 +164,7 @@ fn rows_impl(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
             overlaps[0] += ov;
         }
         *out = [lane_sum(&ax), lane_sum(&ay), lane_sum(&az)];
-        if lane_sum(&overlaps) > 0.0 {
+        if lane_sum(&overlaps) > 1.0 {
             add_overlapping(s, k, i, out);
         }
     }
@@ -176,8 +177,8 @@ fn add_overlapping(s: &SoaSpheres, k: Kernel, i: usize, out: &mut [f64; 3]) {
     for j in 0..s.len() {
         let r = xi - nalgebra::Vector3::new(s.x[j], s.y[j], s.z[j]);
         let r2 = r.norm_squared();
-        let contact = s.a[i] + s.a[j];
-        if j != i && r2 > 0.0 && r2 <= contact * contact {
+        let contact = if k.c3 != 0.0 { s.a[i] + s.a[j] } else { 0.0 };
+        if j != i && r2 <= contact * contact {
             let f = nalgebra::Vector3::new(s.fx[j], s.fy[j], s.fz[j]);
             let v = k.m.pair_apply(k.mu, &r, s.a[i], s.a[j], &f);
             out[0] += v.x;

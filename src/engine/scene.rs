@@ -153,7 +153,7 @@ impl Scene {
     /// length), at length L(t) of the current time. Returns its 0-based index.
     pub fn add(&mut self, d: Dumbbell, center: Vector3<f64>, dir: Vector3<f64>) -> Result<usize> {
         d.validate()?;
-        self.check_room(&d, center, dir)?;
+        self.check_room(&d, center, dir, 0.0)?;
         let n = unit_direction(dir)?;
         let len = d.rest_length(self.time);
         self.swimmers.push(d);
@@ -167,24 +167,39 @@ impl Scene {
         Ok(self.swimmers.len() - 1)
     }
 
-    /// Whether [`Scene::add`] would accept this swimmer (valid, and no sphere overlaps another).
-    pub fn fits(&self, d: &Dumbbell, center: Vector3<f64>, dir: Vector3<f64>) -> bool {
-        d.validate().is_ok() && self.check_room(d, center, dir).is_ok()
+    /// Whether [`Scene::add`] would accept this swimmer with every sphere gap above `margin` (m):
+    /// valid, and no sphere within `margin` of another.
+    pub fn fits(&self, d: &Dumbbell, center: Vector3<f64>, dir: Vector3<f64>, margin: f64) -> bool {
+        d.validate().is_ok() && self.check_room(d, center, dir, margin).is_ok()
     }
 
-    fn check_room(&self, d: &Dumbbell, center: Vector3<f64>, dir: Vector3<f64>) -> Result<()> {
+    /// The length at which swimmer `d`'s spheres sit now: L(t), or ℓ in the averaged model, whose
+    /// swimmers are stroke-averaged (its contact guard and steric repulsion use ℓ too).
+    fn contact_length(&self, d: &Dumbbell) -> f64 {
+        match self.model {
+            Model::Averaged => d.ell,
+            Model::Micro | Model::Rigid => d.rest_length(self.time),
+        }
+    }
+
+    fn check_room(
+        &self,
+        d: &Dumbbell,
+        center: Vector3<f64>,
+        dir: Vector3<f64>,
+        margin: f64,
+    ) -> Result<()> {
         for (k, c) in ["x", "y", "z"].iter().zip(center.iter()) {
             require_finite(&format!("center.{k}"), *c)?;
         }
         let n = unit_direction(dir)?;
-        let len = d.rest_length(self.time);
-        let (x1, x2) = d.sphere_positions(center, n, len);
+        let (x1, x2) = d.sphere_positions(center, n, self.contact_length(d));
         for (s, other) in self.swimmers.iter().enumerate() {
             let (y1, y2) = self.spheres(s);
             for (xa, aa) in [(x1, d.a1), (x2, d.a2)] {
                 for (yb, ab) in [(y1, other.a1), (y2, other.a2)] {
                     let gap = (xa - yb).norm() - aa - ab;
-                    if gap <= 0.0 {
+                    if gap <= margin {
                         return Err(invalid!(
                             "the new swimmer would overlap swimmer {s} (sphere gap {gap:.3e} m); place its centre further away"
                         ));
@@ -346,7 +361,7 @@ impl Scene {
     fn gpu_options_supported(&self) -> std::result::Result<(), String> {
         let cpu_only = |what: &str| Err(format!("{what} runs on the CPU only"));
         match self.model {
-            Model::Micro | Model::Rigid if self.contacts != Contacts::default() => {
+            _ if self.contacts != Contacts::default() => {
                 cpu_only("contact handling (s.overlaps = \"allow\", s.steric)")
             }
             Model::Averaged if self.cutoff.is_some() => cpu_only("the far-field cutoff (s.cutoff)"),
@@ -573,7 +588,7 @@ impl Scene {
         let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
         match self.model {
             Model::Micro => (rh - d.w2() * v, rh + d.w1() * v),
-            Model::Averaged | Model::Rigid => d.sphere_positions(rh, v, d.rest_length(self.time)),
+            Model::Averaged | Model::Rigid => d.sphere_positions(rh, v, self.contact_length(d)),
         }
     }
 
@@ -658,7 +673,7 @@ impl Scene {
             Model::Rigid => {
                 if self.contacts.steric.is_some() {
                     return Err(invalid!(
-                        "steric repulsion needs the microscopic model (the rigid-stroke solve takes dumbbell tensions only); set s.model = \"micro\" or s.steric = ()"
+                        "steric repulsion is not available in the rigid-stroke model (its constraint solve takes dumbbell tensions only); set s.model = \"micro\" or \"averaged\", or s.steric = ()"
                     ));
                 }
                 Box::new(RigidSystem::new(
@@ -678,6 +693,7 @@ impl Scene {
                     &self.state,
                 );
                 sys.set_cutoff(self.cutoff);
+                sys.set_contacts(self.contacts, self.mu);
                 Box::new(sys)
             }
         })

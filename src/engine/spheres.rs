@@ -191,7 +191,7 @@ impl Spheres {
 }
 
 /// The guard's report of spheres `a` < `b` overlapping by −`gap`.
-fn overlap_problem(gap: f64, a: usize, b: usize) -> Problem {
+pub(crate) fn overlap_problem(gap: f64, a: usize, b: usize) -> Problem {
     let (sa, sb) = (a / 2, b / 2);
     let cause = if sa == sb {
         format!("the two spheres of swimmer {sa} overlap (gap {gap:.3e} m)")

@@ -2,7 +2,7 @@
 
 use super::{
     csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, observable_api, render_error,
-    scene_api, stdlib, util_api,
+    scene_api, stdlib, sweep_api, util_api,
 };
 use rhai::{Engine, Scope};
 
@@ -23,6 +23,7 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     float_cmp::register(&mut engine);
     csv_api::register(&mut engine);
     util_api::register(&mut engine);
+    sweep_api::register(&mut engine);
     let embedded = stdlib::install(&mut engine);
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));

@@ -13,6 +13,7 @@ mod observable_api;
 mod render;
 mod scene_api;
 mod show;
+mod sweep_api;
 pub mod stdlib;
 mod util_api;
 

@@ -29,7 +29,7 @@ impl RecorderHandle {
     }
 
     fn with<T>(&self, f: impl FnOnce(&Recorder) -> T) -> ScriptResult<T> {
-        let s = self.scene.0.borrow();
+        let s = self.scene.borrow();
         lift(s.recorder(self.id)).map(f)
     }
 }
@@ -160,7 +160,7 @@ pub fn register(engine: &mut Engine) {
         .register_fn(
             "observe",
             |s: &mut SceneHandle, o: Observable| -> ScriptResult<Dynamic> {
-                lift(o.evaluate(&s.0.borrow())).map(value)
+                lift(o.evaluate(&s.borrow())).map(value)
             },
         );
 
@@ -194,8 +194,8 @@ pub fn register(engine: &mut Engine) {
             |s: &mut SceneHandle, list: Array, every: Dynamic| -> ScriptResult<RecorderHandle> {
                 let obs = observables_of(&list)?;
                 let trigger = trigger_of(&every)?;
-                let rec = lift(Recorder::new(&s.0.borrow(), obs, trigger))?;
-                let id = s.0.borrow_mut().add_recorder(rec);
+                let rec = lift(Recorder::new(&s.borrow(), obs, trigger))?;
+                let id = s.borrow_mut().add_recorder(rec);
                 Ok(RecorderHandle {
                     scene: s.clone(),
                     id,

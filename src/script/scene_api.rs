@@ -1,35 +1,46 @@
 //! `scene()` and the `Scene` type: build, configure, run and read a simulation from a script.
 //!
-//! A scene is big and stateful, so scripts hold a cheap handle (`Rc<RefCell<Scene>>`): `let t = s;`
-//! names the same scene, as in Python.
+//! A scene is big and stateful, so scripts hold a cheap handle (`Arc<RwLock<Scene>>`, shareable
+//! because `sweep` runs script closures on several threads): `let t = s;` names the same scene,
+//! as in Python.
 
 use super::convert::{array3, index, lift, number, script_error, unknown_choice, ScriptResult};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
 use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric};
 use rhai::{Array, Dynamic, Engine, ImmutableString, INT};
-use std::cell::RefCell;
-use std::rc::Rc;
+use std::sync::{Arc, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 /// A script's handle on a scene (Rhai type `Scene`).
 #[derive(Debug, Clone, Default)]
-pub struct SceneHandle(pub Rc<RefCell<Scene>>);
+pub struct SceneHandle(pub Arc<RwLock<Scene>>);
 
 impl SceneHandle {
     /// Wrap a scene.
     pub fn new(scene: Scene) -> Self {
-        SceneHandle(Rc::new(RefCell::new(scene)))
+        SceneHandle(Arc::new(RwLock::new(scene)))
+    }
+
+    /// Read the scene. A lock poisoned by a panic elsewhere still holds a consistent scene (every
+    /// change is made whole or not at all), so it is read anyway.
+    pub fn borrow(&self) -> RwLockReadGuard<'_, Scene> {
+        self.0.read().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Change the scene.
+    pub fn borrow_mut(&self) -> RwLockWriteGuard<'_, Scene> {
+        self.0.write().unwrap_or_else(|e| e.into_inner())
     }
 
     fn with<T>(&self, f: impl FnOnce(&Scene) -> crate::engine::Result<T>) -> ScriptResult<T> {
-        lift(f(&self.0.borrow()))
+        lift(f(&self.borrow()))
     }
 
     fn with_mut<T>(
         &self,
         f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
-        lift(f(&mut self.0.borrow_mut()))
+        lift(f(&mut self.borrow_mut()))
     }
 }
 
@@ -126,7 +137,7 @@ fn add_random(
             }
         }
     }
-    let mut trial = s.0.borrow().clone();
+    let mut trial = s.borrow().clone();
     let side = lift(box_side(n as usize, &d.params, phi))?;
     lift(random_suspension(
         &mut trial,
@@ -137,7 +148,22 @@ fn add_random(
         phases,
         seed as u64,
     ))?;
-    let mut scene = s.0.borrow_mut();
+    let mut scene = s.borrow_mut();
+    let recorders_kept = std::mem::replace(&mut *scene, trial);
+    scene.adopt_recorders(recorders_kept);
+    Ok(scene.count() as INT)
+}
+
+/// `s.add_at(d, centres)`: a copy of d (its orientation and phase) at every centre of the array,
+/// in order; all or nothing (the scene is unchanged if one does not fit).
+fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult<INT> {
+    let mut trial = s.borrow().clone();
+    for (k, c) in centres.iter().enumerate() {
+        let c = super::convert::vector3(&format!("add_at: centre {k}"), c)?;
+        lift(trial.add(d.params, c, d.dir))
+            .map_err(|e| script_error(format!("add_at: centre {k}: {e}")))?;
+    }
+    let mut scene = s.borrow_mut();
     let recorders_kept = std::mem::replace(&mut *scene, trial);
     scene.adopt_recorders(recorders_kept);
     Ok(scene.count() as INT)
@@ -148,8 +174,8 @@ pub fn register(engine: &mut Engine) {
     engine
         .register_type_with_name::<SceneHandle>("Scene")
         .register_fn("scene", SceneHandle::default)
-        .register_fn("to_string", |s: &mut SceneHandle| summary(&s.0.borrow()))
-        .register_fn("to_debug", |s: &mut SceneHandle| summary(&s.0.borrow()));
+        .register_fn("to_string", |s: &mut SceneHandle| summary(&s.borrow()))
+        .register_fn("to_debug", |s: &mut SceneHandle| summary(&s.borrow()));
 
     // Building.
     engine.register_fn(
@@ -189,13 +215,20 @@ pub fn register(engine: &mut Engine) {
          -> ScriptResult<INT> { add_random(s, d, n, &phi, seed, &opts) },
     );
 
+    engine.register_fn(
+        "add_at",
+        |s: &mut SceneHandle, d: DumbbellSpec, centres: Array| -> ScriptResult<INT> {
+            add_at(s, d, &centres)
+        },
+    );
+
     // Properties.
     engine
-        .register_get("time", |s: &mut SceneHandle| s.0.borrow().time())
-        .register_get("count", |s: &mut SceneHandle| s.0.borrow().count() as INT)
+        .register_get("time", |s: &mut SceneHandle| s.borrow().time())
+        .register_get("count", |s: &mut SceneHandle| s.borrow().count() as INT)
         .register_get("period", |s: &mut SceneHandle| s.with(|sc| sc.period()))
-        .register_get("stiff_rate", |s: &mut SceneHandle| s.0.borrow().stiff_rate())
-        .register_get("mu", |s: &mut SceneHandle| s.0.borrow().mu())
+        .register_get("stiff_rate", |s: &mut SceneHandle| s.borrow().stiff_rate())
+        .register_get("mu", |s: &mut SceneHandle| s.borrow().mu())
         .register_set(
             "mu",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
@@ -203,29 +236,29 @@ pub fn register(engine: &mut Engine) {
                 s.with_mut(|sc| sc.set_mu(mu))
             },
         )
-        .register_get("model", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().model().name()))
+        .register_get("model", |s: &mut SceneHandle| ImmutableString::from(s.borrow().model().name()))
         .register_set(
             "model",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let name = string_arg("model", &v)?;
                 let m = Model::parse(&name)
                     .map_err(|_| unknown_choice("model", &name, &["micro", "rigid", "averaged"]))?;
-                s.0.borrow_mut().set_model(m);
+                s.borrow_mut().set_model(m);
                 Ok(())
             },
         )
-        .register_get("mobility", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().mobility().name()))
+        .register_get("mobility", |s: &mut SceneHandle| ImmutableString::from(s.borrow().mobility().name()))
         .register_set(
             "mobility",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let name = string_arg("mobility", &v)?;
                 let m = Mobility::parse(&name)
                     .map_err(|_| unknown_choice("mobility", &name, &["rpy", "oseen"]))?;
-                s.0.borrow_mut().set_mobility(m);
+                s.borrow_mut().set_mobility(m);
                 Ok(())
             },
         )
-        .register_get("backend", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().backend().name()))
+        .register_get("backend", |s: &mut SceneHandle| ImmutableString::from(s.borrow().backend().name()))
         .register_set(
             "backend",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
@@ -237,14 +270,14 @@ pub fn register(engine: &mut Engine) {
                         script_error(format!("s.backend = \"gpu\": {e}"))
                     })?;
                 }
-                s.0.borrow_mut().set_backend(b);
+                s.borrow_mut().set_backend(b);
                 Ok(())
             },
         )
         .register_get("backend_info", |s: &mut SceneHandle| {
             s.with(|sc| sc.backend_info()).map(ImmutableString::from)
         })
-        .register_get("coefficients", |s: &mut SceneHandle| ImmutableString::from(s.0.borrow().coefficients().name()))
+        .register_get("coefficients", |s: &mut SceneHandle| ImmutableString::from(s.borrow().coefficients().name()))
         .register_set(
             "coefficients",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
@@ -252,12 +285,12 @@ pub fn register(engine: &mut Engine) {
                 let c = Coefficients::parse(&name).map_err(|_| {
                     unknown_choice("coefficient set", &name, &["paper", "leading_order"])
                 })?;
-                s.0.borrow_mut().set_coefficients(c);
+                s.borrow_mut().set_coefficients(c);
                 Ok(())
             },
         )
         .register_get("overlaps", |s: &mut SceneHandle| {
-            ImmutableString::from(if s.0.borrow().contacts().allow_overlap { "allow" } else { "stop" })
+            ImmutableString::from(if s.borrow().contacts().allow_overlap { "allow" } else { "stop" })
         })
         .register_set(
             "overlaps",
@@ -268,11 +301,11 @@ pub fn register(engine: &mut Engine) {
                     "allow" => true,
                     _ => return Err(unknown_choice("overlaps setting", &name, &["stop", "allow"])),
                 };
-                s.0.borrow_mut().set_allow_overlap(allow);
+                s.borrow_mut().set_allow_overlap(allow);
                 Ok(())
             },
         )
-        .register_get("steric", |s: &mut SceneHandle| match s.0.borrow().contacts().steric {
+        .register_get("steric", |s: &mut SceneHandle| match s.borrow().contacts().steric {
             Some(st) => {
                 let mut m = rhai::Map::new();
                 m.insert("range".into(), Dynamic::from_float(st.range));
@@ -282,27 +315,27 @@ pub fn register(engine: &mut Engine) {
             None => Dynamic::UNIT,
         })
         .register_set("steric", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-            s.0.borrow_mut().set_steric(steric_arg(&v)?);
+            s.borrow_mut().set_steric(steric_arg(&v)?);
             Ok(())
         })
         .register_get("cutoff", |s: &mut SceneHandle| {
-            s.0.borrow().cutoff().map_or(Dynamic::UNIT, Dynamic::from_float)
+            s.borrow().cutoff().map_or(Dynamic::UNIT, Dynamic::from_float)
         })
         .register_set("cutoff", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
             let c = if v.is_unit() { None } else { Some(number("s.cutoff", &v)?) };
             s.with_mut(|sc| sc.set_cutoff(c))
         })
-        .register_get("integrator", |s: &mut SceneHandle| s.0.borrow().integrator())
+        .register_get("integrator", |s: &mut SceneHandle| s.borrow().integrator())
         .register_set(
             "integrator",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 if let Some(spec) = v.clone().try_cast::<IntegratorSpec>() {
-                    s.0.borrow_mut().set_integrator(Some(spec));
+                    s.borrow_mut().set_integrator(Some(spec));
                     return Ok(());
                 }
                 match v.clone().into_immutable_string() {
                     Ok(name) if name == "default" => {
-                        s.0.borrow_mut().set_integrator(None);
+                        s.borrow_mut().set_integrator(None);
                         Ok(())
                     }
                     Ok(name) => Err(unknown_choice("integrator", &name, &["default"])),
@@ -375,7 +408,7 @@ pub fn register(engine: &mut Engine) {
     // Phases, copies, files.
     engine
         .register_get("phases", |s: &mut SceneHandle| -> Array {
-            s.0.borrow()
+            s.borrow()
                 .phases()
                 .into_iter()
                 .map(Dynamic::from_float)
@@ -406,7 +439,7 @@ pub fn register(engine: &mut Engine) {
             },
         )
         .register_fn("copy", |s: &mut SceneHandle| {
-            SceneHandle::new(s.0.borrow().clone())
+            SceneHandle::new(s.borrow().clone())
         })
         .register_fn(
             "save",
@@ -445,7 +478,7 @@ pub fn register(engine: &mut Engine) {
             },
         )
         .register_get("stats", |s: &mut SceneHandle| {
-            let st = s.0.borrow().stats();
+            let st = s.borrow().stats();
             let mut m = rhai::Map::new();
             m.insert("steps".into(), (st.steps as INT).into());
             m.insert("rejected".into(), (st.rejected as INT).into());

@@ -10,7 +10,7 @@ use rhai::{Array, Dynamic, Map};
 /// Text for a value printed by the REPL.
 pub fn show(v: &Dynamic) -> String {
     if let Some(s) = v.clone().try_cast::<SceneHandle>() {
-        return summary(&s.0.borrow());
+        return summary(&s.borrow());
     }
     if let Some(d) = v.clone().try_cast::<DumbbellSpec>() {
         return d.to_string();

@@ -9,6 +9,7 @@ pub const MODULES: &[(&str, &str)] = &[
     ("paper", include_str!("../../stdlib/paper.rhai")),
     ("phases", include_str!("../../stdlib/phases.rhai")),
     ("measure", include_str!("../../stdlib/measure.rhai")),
+    ("lattice", include_str!("../../stdlib/lattice.rhai")),
 ];
 
 /// Compile the embedded modules with `engine`, install the resolver (embedded modules first, then

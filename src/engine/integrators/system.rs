@@ -62,7 +62,7 @@ pub struct Stats {
 }
 
 /// One time-stepping method.
-pub trait Stepper {
+pub trait Stepper: Send + Sync {
     /// Advance `y` from `t` towards `t_end` (never past it) and return the new time. On `Err` the
     /// state `y` is left as it was.
     fn step(
