@@ -83,7 +83,13 @@ fn systems(model: Model) -> (Box<dyn OdeSystem>, Vec<f64>) {
             Mobility::Rpy,
             Default::default(),
         )),
-        Model::Rigid => Box::new(RigidSystem::new(s.swimmers(), base, 1e-3, Mobility::Rpy, false)),
+        Model::Rigid => Box::new(RigidSystem::new(
+            s.swimmers(),
+            base,
+            1e-3,
+            Mobility::Rpy,
+            false,
+        )),
         Model::Averaged => Box::new(AveragedSystem::new(
             s.swimmers(),
             base,

@@ -8,6 +8,34 @@ use std::process::ExitCode;
 /// The experiment run by `swimlab run` without a file: the paper's Fig-1 pair.
 const DEFAULT_SCRIPT: &str = include_str!("../scripts/pair.rhai");
 
+/// The paper's figure scripts, built in for `swimlab make-figures`.
+const PAPER_SCRIPTS: &[(&str, &str)] = &[
+    (
+        "scripts/paper/fig1a.rhai",
+        include_str!("../scripts/paper/fig1a.rhai"),
+    ),
+    (
+        "scripts/paper/fig1b.rhai",
+        include_str!("../scripts/paper/fig1b.rhai"),
+    ),
+    (
+        "scripts/paper/fig2a.rhai",
+        include_str!("../scripts/paper/fig2a.rhai"),
+    ),
+    (
+        "scripts/paper/fig2b.rhai",
+        include_str!("../scripts/paper/fig2b.rhai"),
+    ),
+    (
+        "scripts/paper/fig3.rhai",
+        include_str!("../scripts/paper/fig3.rhai"),
+    ),
+    (
+        "scripts/paper/fig4.rhai",
+        include_str!("../scripts/paper/fig4.rhai"),
+    ),
+];
+
 #[derive(Parser)]
 #[command(
     name = "swimlab",
@@ -49,6 +77,16 @@ enum Command {
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
     },
+    /// Render every figure of the paper (scripts/paper, built in): CSV and PNG to out/paper/,
+    /// and the PNGs also to --out if given (e.g. docs/figures for the README).
+    MakeFigures {
+        /// The scripts' quick variants (fewer points and periods).
+        #[arg(long)]
+        quick: bool,
+        /// Also copy the pictures here.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -70,7 +108,7 @@ enum BenchKind {
 }
 
 fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
-    use swimlab::bench::{backends, pairs, scaling, stability, work_precision};
+    use swimlab::bench::{backends, pairs, plots, scaling, stability, work_precision};
     use swimlab::engine::Model;
     let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
     match which {
@@ -97,6 +135,13 @@ fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
                 );
                 t.write_csv(&std::path::Path::new("out/bench").join(file))
                     .map_err(io)?;
+                for (k, (config, ..)) in work_precision::CONFIGS.iter().enumerate() {
+                    if let Some(f) = plots::work_precision(&points, config) {
+                        let png = format!("out/bench/{}_{k}.png", file.trim_end_matches(".csv"));
+                        f.save(std::path::Path::new(&png))?;
+                        println!("picture: {png}");
+                    }
+                }
             }
             println!("\nCSV written to out/bench/");
         }
@@ -140,6 +185,8 @@ fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
             }
             t.write_csv(std::path::Path::new("out/bench/scaling.csv"))
                 .map_err(io)?;
+            plots::scaling(&rows).save(std::path::Path::new("out/bench/scaling.png"))?;
+            println!("picture: out/bench/scaling.png");
             println!("\nCSV written to out/bench/scaling.csv");
         }
         BenchKind::Backends => {
@@ -164,6 +211,8 @@ fn bench(which: BenchKind, quick: bool) -> Result<(), String> {
             }
             t.write_csv(std::path::Path::new("out/bench/backends.csv"))
                 .map_err(io)?;
+            plots::backends(&rows).save(std::path::Path::new("out/bench/backends.png"))?;
+            println!("picture: out/bench/backends.png");
             println!("\nCSV written to out/bench/backends.csv");
         }
     }
@@ -197,6 +246,34 @@ fn parse_set(item: &str) -> Result<(String, Dynamic), String> {
     Ok((name.to_string(), v))
 }
 
+/// Run the built-in figure scripts and copy their pictures to `out`.
+fn make_figures(quick: bool, out: Option<&std::path::Path>) -> Result<(), String> {
+    if quick {
+        std::env::set_var("SWIMLAB_QUICK", "1");
+    }
+    for (name, source) in PAPER_SCRIPTS {
+        let start = std::time::Instant::now();
+        swimlab::script::run_source(name, source, &mut Scope::new())?;
+        println!("{name}: {:.1} s", start.elapsed().as_secs_f64());
+    }
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        let entries =
+            std::fs::read_dir("out/paper").map_err(|e| format!("cannot read out/paper: {e}"))?;
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if path.extension().is_some_and(|e| e == "png") {
+                let to = dir.join(entry.file_name());
+                std::fs::copy(&path, &to)
+                    .map_err(|e| format!("cannot copy to {}: {e}", to.display()))?;
+                println!("copied {}", to.display());
+            }
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let mut scope = Scope::new();
@@ -214,6 +291,7 @@ fn main() -> ExitCode {
     } else {
         match cli.command {
             Some(Command::Bench { which, quick }) => bench(which, quick),
+            Some(Command::MakeFigures { quick, out }) => make_figures(quick, out.as_deref()),
             Some(Command::Run { file, quick, set }) => {
                 if quick {
                     // Read by `quick()` in scripts; set before any other thread exists.

@@ -143,7 +143,10 @@ fn rpy_stays_positive_definite_when_spheres_overlap() {
         assert!(asym < 1e-15, "asymmetry {asym:e}");
         let eig = m.symmetric_eigenvalues();
         let min = eig.min() / eig.max();
-        assert!(min > 0.0, "trial {trial}: smallest eigenvalue ratio {min:e}");
+        assert!(
+            min > 0.0,
+            "trial {trial}: smallest eigenvalue ratio {min:e}"
+        );
     }
     assert!(overlapping_configs > 50, "the configurations must overlap");
 }
@@ -163,7 +166,10 @@ fn overlapping_form_is_continuous_with_mazur_at_contact_and_with_drag_inside() {
             let out = Mobility::Rpy.pair_tensor(MU, &(r_hat * (d + eps)), ai, aj);
             let inn = Mobility::Rpy.pair_tensor(MU, &(r_hat * (d - eps)), ai, aj);
             let jump = (out - inn).amax() / out.amax();
-            assert!(jump < 2e-9, "a = ({ai:e}, {aj:e}), d = {d:e}: jump {jump:e}");
+            assert!(
+                jump < 2e-9,
+                "a = ({ai:e}, {aj:e}), d = {d:e}: jump {jump:e}"
+            );
             if inner {
                 let drag = Matrix3::identity() / (6.0 * PI * MU * ai.max(aj));
                 assert!((inn - drag).amax() < 1e-12 * drag.amax());

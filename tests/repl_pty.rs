@@ -69,3 +69,15 @@ fn transcript_of_a_session() {
     s.send(ControlCode::EndOfTransmission).unwrap();
     s.expect(Eof).expect("Ctrl-D ends the session");
 }
+
+// A run longer than half a second at a terminal shows a progress bar (periods done, rate, ETA),
+// cleared when the run ends.
+#[test]
+fn long_runs_show_a_progress_bar() {
+    let mut s = start();
+    step(&mut s, "let s = scene(); s.add(dumbbell());", "");
+    s.send_line("s.run_periods(3000); s.count").unwrap();
+    s.expect("periods/s").expect("a progress bar");
+    s.expect("=> 1").unwrap();
+    s.expect(PROMPT).unwrap();
+}

@@ -15,7 +15,16 @@ fn suspension(model: Model, n: usize, phi: f64, d: Dumbbell, seed: u64) -> Scene
     let mut s = Scene::new();
     s.set_model(model);
     let side = box_side(n, &d, phi).unwrap();
-    random_suspension(&mut s, n, d, side, Orientations::Random, Phases::Random, seed).unwrap();
+    random_suspension(
+        &mut s,
+        n,
+        d,
+        side,
+        Orientations::Random,
+        Phases::Random,
+        seed,
+    )
+    .unwrap();
     s
 }
 
@@ -42,7 +51,10 @@ fn thousand_swimmer_averaged_run_stays_finite() {
     s.run_periods(3.0, &never).unwrap();
     assert!(all_finite(&s));
     let p = Observable::Polarization.evaluate(&s).unwrap()[0];
-    assert!(p.is_finite() && p < 0.2, "random orientations: polarization {p}");
+    assert!(
+        p.is_finite() && p < 0.2,
+        "random orientations: polarization {p}"
+    );
 }
 
 // Issue 7: a 200-swimmer microscopic run (400 spheres, the fast kernel in parallel) for a few
@@ -197,9 +209,12 @@ fn pair_distance_histogram_counts_pairs() {
     }
     assert_eq!(hist, expected);
     assert_eq!(hist.iter().sum::<f64>(), 15.0);
-    assert!(Observable::PairDistances { bins: 0, r_max: 1.0 }
-        .check(&s)
-        .is_err());
+    assert!(Observable::PairDistances {
+        bins: 0,
+        r_max: 1.0
+    }
+    .check(&s)
+    .is_err());
 }
 
 // In the averaged model the mean speed is ⟨|dR_H/dt|⟩ of the model's own rates.
@@ -212,7 +227,10 @@ fn mean_speed_is_the_mean_of_the_rates() {
         .sum::<f64>()
         / 40.0;
     let got = Observable::MeanSpeed.evaluate(&s).unwrap()[0];
-    assert!((got - expected).abs() <= 1e-14 * expected, "{got:e} vs {expected:e}");
+    assert!(
+        (got - expected).abs() <= 1e-14 * expected,
+        "{got:e} vs {expected:e}"
+    );
 }
 
 fn script(src: &str) -> Result<(), String> {
@@ -241,7 +259,10 @@ fn sweep_returns_results_in_order_and_names_a_failing_parameter() {
     )
     .unwrap();
     let err = script("sweep([1, 2, 3], |p| if p == 2 { throw \"bad\" } else { p });").unwrap_err();
-    assert!(err.contains("parameter 1 (2)") && err.contains("bad"), "{err}");
+    assert!(
+        err.contains("parameter 1 (2)") && err.contains("bad"),
+        "{err}"
+    );
     let err = script("sweep([1], |p| p, 0);").unwrap_err();
     assert!(err.contains("threads must be at least 1"), "{err}");
 }

@@ -3,6 +3,7 @@
 
 pub mod backends;
 pub mod pairs;
+pub mod plots;
 pub mod scaling;
 pub mod stability;
 pub mod table;

@@ -286,7 +286,9 @@ impl AveragedSystem {
     pub fn far_pair_bound(&self, s: usize, distance: f64) -> (f64, f64) {
         let c = &self.coef[s];
         let xi = c.ell / distance;
-        let v = 9.0 / 64.0 * c.v0 * (28.0 * c.a_r.abs() * c.big_l * xi.powi(3) + 84.0 * c.c_j * xi.powi(4));
+        let v = 9.0 / 64.0
+            * c.v0
+            * (28.0 * c.a_r.abs() * c.big_l * xi.powi(3) + 84.0 * c.c_j * xi.powi(4));
         let w = c.w0
             * c.big_l
             * (15.0 / 64.0 * 148.0 * xi.powi(5) + 9.0 / 32.0 * 68.0 * c.a_n.abs() * xi.powi(4));
@@ -350,7 +352,11 @@ impl AveragedSystem {
             let Some(sin) = self.pair_sin(s, r) else {
                 continue;
             };
-            let dvec = Vector3::new(soa.x[s] - soa.x[r], soa.y[s] - soa.y[r], soa.z[s] - soa.z[r]);
+            let dvec = Vector3::new(
+                soa.x[s] - soa.x[r],
+                soa.y[s] - soa.y[r],
+                soa.z[s] - soa.z[r],
+            );
             let d2 = dvec.norm_squared();
             if d2 > self.cutoff2 {
                 continue;
@@ -499,8 +505,7 @@ impl OdeSystem for AveragedSystem {
                     return None;
                 }
                 let (gap, k, m) = self.closest_spheres(s, r);
-                (gap <= 0.0)
-                    .then(|| super::spheres::overlap_problem(gap, 2 * s + k, 2 * r + m))
+                (gap <= 0.0).then(|| super::spheres::overlap_problem(gap, 2 * s + k, 2 * r + m))
             })
         };
         let found = if n >= PARALLEL_SWIMMERS {

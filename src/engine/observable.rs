@@ -237,7 +237,10 @@ impl Observable {
         };
         // Counts are integers in f64: the sum is exact in any order.
         Ok(if c.len() >= 256 {
-            (0..c.len()).into_par_iter().map(row).reduce(|| vec![0.0; bins], add)
+            (0..c.len())
+                .into_par_iter()
+                .map(row)
+                .reduce(|| vec![0.0; bins], add)
         } else {
             (0..c.len()).map(row).fold(vec![0.0; bins], add)
         })

@@ -78,7 +78,14 @@ pub struct Scene {
     /// Recorders: operations on the scene, not its state (neither saved nor cloned).
     #[serde(skip)]
     recorders: Vec<Recorder>,
+    /// Told the scene time as a run advances (neither saved nor cloned).
+    #[serde(skip)]
+    progress: Option<Progress>,
 }
+
+/// A run's progress report: called with the scene time after every CPU step and after every
+/// device run segment, e.g. to draw a progress bar. It must be cheap.
+pub type Progress = std::sync::Arc<dyn Fn(f64) + Send + Sync>;
 
 impl Default for Scene {
     fn default() -> Self {
@@ -99,6 +106,7 @@ impl Default for Scene {
             gpu: None,
             stepper: None,
             recorders: Vec::new(),
+            progress: None,
         }
     }
 }
@@ -123,6 +131,7 @@ impl Clone for Scene {
             gpu: None,
             stepper: None,
             recorders: Vec::new(),
+            progress: None,
         }
     }
 }
@@ -686,12 +695,8 @@ impl Scene {
             }
             Model::Averaged => {
                 self.check_averaged()?;
-                let mut sys = AveragedSystem::new(
-                    &self.swimmers,
-                    &self.base,
-                    self.coefficients,
-                    &self.state,
-                );
+                let mut sys =
+                    AveragedSystem::new(&self.swimmers, &self.base, self.coefficients, &self.state);
                 sys.set_cutoff(self.cutoff);
                 sys.set_contacts(self.contacts, self.mu);
                 Box::new(sys)
@@ -831,6 +836,7 @@ impl Scene {
             };
             self.stats.steps += done;
             self.stats.rhs_evals += done * stages + 1;
+            self.report();
             match outcome {
                 Ok(RunOutcome::Interrupted { .. }) => {
                     break Err(EngineError::Interrupted { time: self.time })
@@ -879,7 +885,10 @@ impl Scene {
                 t_end,
                 &mut self.stats,
             ) {
-                Ok(t) => self.time = t,
+                Ok(t) => {
+                    self.time = t;
+                    self.report();
+                }
                 Err(f) => {
                     outcome = Err(EngineError::StepFailed {
                         time: f.time,
@@ -894,6 +903,18 @@ impl Scene {
         }
         self.stepper = Some((spec, stepper));
         outcome
+    }
+
+    /// Report progress to `p` during runs (`None`: no reports).
+    pub fn set_progress(&mut self, p: Option<Progress>) {
+        self.progress = p;
+    }
+
+    /// Tell the progress report the current time.
+    fn report(&self) {
+        if let Some(p) = &self.progress {
+            p(self.time);
+        }
     }
 
     /// Take over the recorders of `old`, which this scene replaces.

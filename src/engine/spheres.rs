@@ -80,7 +80,12 @@ impl Spheres {
         let n = self.pos.len();
         if let Some(st) = self.contacts.steric {
             self.steric.fill(Vector3::zeros());
-            st.add_forces(&self.pos, &self.radii, &mut self.steric, n >= PARALLEL_SPHERES);
+            st.add_forces(
+                &self.pos,
+                &self.radii,
+                &mut self.steric,
+                n >= PARALLEL_SPHERES,
+            );
             for (f, s) in self.forces.iter_mut().zip(&self.steric) {
                 *f += s;
             }

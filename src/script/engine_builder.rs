@@ -1,8 +1,8 @@
 //! The one place a Rhai engine is built and scripts are run.
 
 use super::{
-    csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, observable_api, render_error,
-    scene_api, stdlib, sweep_api, util_api,
+    csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, observable_api, plot_api,
+    render_error, scene_api, stdlib, sweep_api, util_api,
 };
 use rhai::{Engine, Scope};
 
@@ -24,6 +24,7 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     csv_api::register(&mut engine);
     util_api::register(&mut engine);
     sweep_api::register(&mut engine);
+    plot_api::register(&mut engine);
     let embedded = stdlib::install(&mut engine);
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));

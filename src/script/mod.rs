@@ -10,11 +10,13 @@ mod float_cmp;
 mod integrator_api;
 pub mod interrupt;
 mod observable_api;
+mod plot_api;
+mod progress;
 mod render;
 mod scene_api;
 mod show;
-mod sweep_api;
 pub mod stdlib;
+mod sweep_api;
 mod util_api;
 
 pub use convert::{script_error, ScriptResult};

@@ -28,7 +28,7 @@ impl RecorderHandle {
         .unwrap_or_else(|e| e.to_string())
     }
 
-    fn with<T>(&self, f: impl FnOnce(&Recorder) -> T) -> ScriptResult<T> {
+    pub(crate) fn with<T>(&self, f: impl FnOnce(&Recorder) -> T) -> ScriptResult<T> {
         let s = self.scene.borrow();
         lift(s.recorder(self.id)).map(f)
     }

@@ -53,24 +53,33 @@ fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {
 
 /// `s.steric = #{ range, stiffness }` (m, N/m) or `()` for none.
 fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
-    const FIX: &str = "use s.steric = #{ range: 1e-7, stiffness: 1e-3 } (m, N/m), or s.steric = () for none";
+    const FIX: &str =
+        "use s.steric = #{ range: 1e-7, stiffness: 1e-3 } (m, N/m), or s.steric = () for none";
     if v.is_unit() {
         return Ok(None);
     }
     let Some(map) = v.clone().try_cast::<rhai::Map>() else {
-        return Err(script_error(format!("s.steric must be a map or (), got {v}; {FIX}")));
+        return Err(script_error(format!(
+            "s.steric must be a map or (), got {v}; {FIX}"
+        )));
     };
     let (mut range, mut stiffness) = (None, None);
     for (k, val) in &map {
         match k.as_str() {
             "range" => range = Some(number("steric range", val)?),
             "stiffness" => stiffness = Some(number("steric stiffness", val)?),
-            other => return Err(script_error(format!("s.steric: unknown key \"{other}\"; {FIX}"))),
+            other => {
+                return Err(script_error(format!(
+                    "s.steric: unknown key \"{other}\"; {FIX}"
+                )))
+            }
         }
     }
     match (range, stiffness) {
         (Some(r), Some(k)) => lift(Steric::new(r, k)).map(Some),
-        _ => Err(script_error(format!("s.steric needs both range and stiffness; {FIX}"))),
+        _ => Err(script_error(format!(
+            "s.steric needs both range and stiffness; {FIX}"
+        ))),
     }
 }
 
@@ -167,6 +176,25 @@ fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult
     let recorders_kept = std::mem::replace(&mut *scene, trial);
     scene.adopt_recorders(recorders_kept);
     Ok(scene.count() as INT)
+}
+
+/// Run `f` with a progress bar over the next `duration` seconds (only at a terminal).
+fn with_bar<T>(
+    sc: &mut Scene,
+    duration: f64,
+    f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
+) -> crate::engine::Result<T> {
+    let t0 = sc.time();
+    match super::progress::RunBar::start(t0, t0 + duration, sc.period().ok()) {
+        Some((bar, report)) => {
+            sc.set_progress(Some(report));
+            let r = f(sc);
+            sc.set_progress(None);
+            drop(bar);
+            r
+        }
+        None => f(sc),
+    }
 }
 
 /// Register the `Scene` type and its methods and properties.
@@ -467,14 +495,17 @@ pub fn register(engine: &mut Engine) {
             "run",
             |s: &mut SceneHandle, duration: Dynamic| -> ScriptResult<()> {
                 let d = number("run(duration)", &duration)?;
-                s.with_mut(|sc| sc.run(d, &interrupt::requested))
+                s.with_mut(|sc| with_bar(sc, d, |sc| sc.run(d, &interrupt::requested)))
             },
         )
         .register_fn(
             "run_periods",
             |s: &mut SceneHandle, n: Dynamic| -> ScriptResult<()> {
                 let n = number("run_periods(n)", &n)?;
-                s.with_mut(|sc| sc.run_periods(n, &interrupt::requested))
+                s.with_mut(|sc| {
+                    let d = sc.period().map_or(0.0, |t| n * t);
+                    with_bar(sc, d, |sc| sc.run_periods(n, &interrupt::requested))
+                })
             },
         )
         .register_get("stats", |s: &mut SceneHandle| {

@@ -10,6 +10,7 @@ pub const MODULES: &[(&str, &str)] = &[
     ("phases", include_str!("../../stdlib/phases.rhai")),
     ("measure", include_str!("../../stdlib/measure.rhai")),
     ("lattice", include_str!("../../stdlib/lattice.rhai")),
+    ("figures", include_str!("../../stdlib/figures.rhai")),
 ];
 
 /// Compile the embedded modules with `engine`, install the resolver (embedded modules first, then

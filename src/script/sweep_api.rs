@@ -62,7 +62,11 @@ pub fn register(engine: &mut Engine) {
         )
         .register_fn(
             "sweep",
-            |ctx: NativeCallContext, params: Array, f: FnPtr, threads: INT| -> ScriptResult<Array> {
+            |ctx: NativeCallContext,
+             params: Array,
+             f: FnPtr,
+             threads: INT|
+             -> ScriptResult<Array> {
                 if threads < 1 {
                     return Err(script_error(format!(
                         "sweep(params, f, threads): threads must be at least 1, got {threads}"

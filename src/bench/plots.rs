@@ -1,0 +1,127 @@
+//! The benchmark tables as log-log pictures (written next to their CSV files in out/bench/).
+
+use super::backends::Row as BackendRow;
+use super::scaling::{self, Row as ScalingRow};
+use super::work_precision::Point;
+use crate::engine::Model;
+use crate::plot::{Figure, Legend, Series, Style};
+use std::collections::BTreeMap;
+
+/// Work against precision for one configuration: wall time against the drift's error, one line
+/// per model and method family, ordered by error. Exact results (error 0) cannot go on a log
+/// axis and are left out of the picture (they stay in the table).
+pub fn work_precision(points: &[Point], config: &str) -> Option<Figure> {
+    let mut families: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    for p in points
+        .iter()
+        .filter(|p| p.config == config && p.err_drift > 0.0)
+    {
+        let spec = p.spec.to_string();
+        let family = spec.split('(').next().unwrap_or(&spec).to_string();
+        families
+            .entry(format!("{} {family}", p.model.name()))
+            .or_default()
+            .push((p.err_drift, p.seconds));
+    }
+    if families.is_empty() {
+        return None;
+    }
+    let series = families
+        .into_iter()
+        .map(|(label, mut pts)| {
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            Series {
+                label,
+                x: pts.iter().map(|p| p.0).collect(),
+                y: pts.iter().map(|p| p.1).collect(),
+                style: if pts.len() > 1 {
+                    Style::Line
+                } else {
+                    Style::Points
+                },
+                color: None,
+            }
+        })
+        .collect();
+    Some(Figure {
+        title: format!("work against precision: {config}"),
+        x_label: "relative error of the drift".into(),
+        y_label: "wall time [s]".into(),
+        log_x: true,
+        log_y: true,
+        series,
+        legend: Legend::UpperRight,
+        ..Figure::default()
+    })
+}
+
+/// Seconds per RK4 step against size, CPU and GPU, both models.
+pub fn backends(rows: &[BackendRow]) -> Figure {
+    let mut series = Vec::new();
+    for model in [Model::Micro, Model::Averaged] {
+        for (gpu, name) in [(false, "cpu"), (true, "gpu")] {
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.model == model)
+                .filter_map(|r| Some((r.size as f64, if gpu { r.gpu? } else { r.cpu? })))
+                .collect();
+            if !pts.is_empty() {
+                series.push(Series {
+                    label: format!("{} {name}", model.name()),
+                    x: pts.iter().map(|p| p.0).collect(),
+                    y: pts.iter().map(|p| p.1).collect(),
+                    style: Style::Line,
+                    color: None,
+                });
+            }
+        }
+    }
+    Figure {
+        title: "time per RK4 step, CPU and GPU".into(),
+        x_label: "spheres (micro) or swimmers (averaged)".into(),
+        y_label: "wall time per step [s]".into(),
+        log_x: true,
+        log_y: true,
+        series,
+        legend: Legend::UpperLeft,
+        ..Figure::default()
+    }
+}
+
+/// Cost per period against the number of swimmers, both models, with the fitted power laws.
+pub fn scaling(rows: &[ScalingRow]) -> Figure {
+    let mut series = Vec::new();
+    for (k, model) in [Model::Micro, Model::Averaged].into_iter().enumerate() {
+        let mine: Vec<&ScalingRow> = rows.iter().filter(|r| r.model == model).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        series.push(Series {
+            label: model.name().into(),
+            x: mine.iter().map(|r| r.swimmers as f64).collect(),
+            y: mine.iter().map(|r| r.per_period()).collect(),
+            style: Style::Points,
+            color: Some(k),
+        });
+        if let Some((slope, c)) = scaling::fit(rows, model, 256) {
+            let xs: Vec<f64> = mine.iter().map(|r| r.swimmers as f64).collect();
+            series.push(Series {
+                label: format!("{c:.2e} S^{slope:.2} (fit, S >= 256)"),
+                y: xs.iter().map(|x| c * x.powf(slope)).collect(),
+                x: xs,
+                style: Style::Line,
+                color: Some(k),
+            });
+        }
+    }
+    Figure {
+        title: "cost per stroke period on the CPU".into(),
+        x_label: "swimmers S".into(),
+        y_label: "wall time per period [s]".into(),
+        log_x: true,
+        log_y: true,
+        series,
+        legend: Legend::UpperLeft,
+        ..Figure::default()
+    }
+}

@@ -1,0 +1,270 @@
+//! Pictures of what swimlab measures: line and point plots of series to SVG or PNG files, quick
+//! plots as text for the terminal, and snapshots of a scene (its spheres projected on a plane).
+//!
+//! This layer sits between the engine and the script bindings: it reads engine types (a
+//! [`crate::engine::Scene`] for snapshots) and knows nothing of Rhai. Files are drawn with
+//! plotters, headless: text is set in an embedded subset of DejaVu Sans, so no system font is
+//! needed.
+
+mod render;
+mod snapshot;
+mod text;
+
+pub use snapshot::{snapshot, Plane, SnapshotOptions};
+pub use text::render_text;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// Straight segments between consecutive points.
+    Line,
+    /// A marker at every point.
+    Points,
+}
+
+impl Style {
+    /// Parse "line" or "points".
+    pub fn parse(name: &str) -> Result<Self, String> {
+        match name {
+            "line" => Ok(Style::Line),
+            "points" => Ok(Style::Points),
+            other => Err(format!(
+                "unknown style \"{other}\"; use \"line\" or \"points\""
+            )),
+        }
+    }
+}
+
+/// One named series of (x, y) points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend entry (empty: none).
+    pub label: String,
+    /// Abscissae.
+    pub x: Vec<f64>,
+    /// Ordinates.
+    pub y: Vec<f64>,
+    /// Line or points.
+    pub style: Style,
+    /// Palette index into [`COLORS`]; `None`: the series' own index.
+    pub color: Option<usize>,
+}
+
+/// A plot: axes with labels (units included by the caller), optional log scales, and series.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// Caption above the plot.
+    pub title: String,
+    /// x axis label, e.g. "time [s]".
+    pub x_label: String,
+    /// y axis label.
+    pub y_label: String,
+    /// Logarithmic x axis.
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The series, drawn in order with the colours of [`COLORS`].
+    pub series: Vec<Series>,
+    /// Where the legend goes (if any series has a label).
+    pub legend: Legend,
+}
+
+/// Legend placement inside the plot area.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Legend {
+    /// Top right (the default).
+    #[default]
+    UpperRight,
+    /// Top left.
+    UpperLeft,
+    /// Bottom right.
+    LowerRight,
+    /// Bottom left.
+    LowerLeft,
+    /// No legend.
+    None,
+}
+
+impl Legend {
+    /// Parse "upper right", "upper left", "lower right", "lower left" or "none".
+    pub fn parse(name: &str) -> Result<Self, String> {
+        Ok(match name {
+            "upper right" => Legend::UpperRight,
+            "upper left" => Legend::UpperLeft,
+            "lower right" => Legend::LowerRight,
+            "lower left" => Legend::LowerLeft,
+            "none" => Legend::None,
+            other => {
+                return Err(format!(
+                    "unknown legend place \"{other}\"; use \"upper right\", \"upper left\", \"lower right\", \"lower left\" or \"none\""
+                ))
+            }
+        })
+    }
+}
+
+impl Default for Figure {
+    fn default() -> Self {
+        Figure {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            log_x: false,
+            log_y: false,
+            width: 800,
+            height: 500,
+            series: Vec::new(),
+            legend: Legend::default(),
+        }
+    }
+}
+
+/// A number for an axis whose visible range is `span` wide: enough significant digits that
+/// neighbouring ticks (about a tenth of the span apart) differ, e.g. 5.0000100e-5 and
+/// 5.0000200e-5 on a 1e-10 span, compact otherwise;
+/// values within 1e-9 of the span from zero are zero (a tick at −1.7e-21 is a rounded 0).
+pub fn format_number(v: f64, span: f64) -> String {
+    if v == 0.0 || v.abs() < 1e-9 * span.abs() {
+        return "0".into();
+    }
+    let digits = if span > 0.0 && span.is_finite() {
+        // Axes carry about ten ticks: resolve a tenth of the span.
+        ((v.abs() / (0.1 * span)).log10().ceil() as i64 + 1).clamp(1, 15) as usize
+    } else {
+        3
+    };
+    if (1e-3..1e4).contains(&v.abs()) && digits <= 6 {
+        let decimals = (digits as i64 - 1 - v.abs().log10().floor() as i64).clamp(0, 15) as usize;
+        let s = format!("{v:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        let d = digits.saturating_sub(1);
+        format!("{v:.d$e}")
+    }
+}
+
+/// Series colours (the "tab10" palette), reused in turn.
+pub const COLORS: [(u8, u8, u8); 10] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (214, 39, 40),
+    (148, 103, 189),
+    (140, 86, 75),
+    (227, 119, 194),
+    (127, 127, 127),
+    (188, 189, 34),
+    (23, 190, 207),
+];
+
+/// File formats by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Scalable vector graphics.
+    Svg,
+    /// Portable network graphics.
+    Png,
+}
+
+impl Format {
+    /// The format a path's extension names.
+    pub fn of(path: &std::path::Path) -> Result<Self, String> {
+        match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("svg") => Ok(Format::Svg),
+            Some(e) if e.eq_ignore_ascii_case("png") => Ok(Format::Png),
+            _ => Err(format!(
+                "cannot tell the picture format of \"{}\"; end the file name in .svg or .png",
+                path.display()
+            )),
+        }
+    }
+}
+
+impl Figure {
+    /// Check that the figure can be drawn: at least one series, x and y of equal length, finite
+    /// values, and positive values on log axes; sizes between 100 and 8000 pixels.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.series.is_empty() {
+            return Err("a plot needs at least one series, e.g. #{ x: [1, 2], y: [3, 4] }".into());
+        }
+        for (w, what) in [(self.width, "width"), (self.height, "height")] {
+            if !(100..=8000).contains(&w) {
+                return Err(format!("plot {what} must be 100 to 8000 pixels, got {w}"));
+            }
+        }
+        for (k, s) in self.series.iter().enumerate() {
+            let name = if s.label.is_empty() {
+                format!("series {k}")
+            } else {
+                format!("series {k} (\"{}\")", s.label)
+            };
+            if s.x.len() != s.y.len() {
+                return Err(format!(
+                    "{name} has {} x values but {} y values; give both the same length",
+                    s.x.len(),
+                    s.y.len()
+                ));
+            }
+            if s.x.is_empty() {
+                return Err(format!("{name} has no points"));
+            }
+            for (axis, v, log) in [("x", &s.x, self.log_x), ("y", &s.y, self.log_y)] {
+                if let Some(i) = v.iter().position(|v| !v.is_finite()) {
+                    return Err(format!(
+                        "{name}: {axis}[{i}] is {}, not a finite number",
+                        v[i]
+                    ));
+                }
+                if log {
+                    if let Some(i) = v.iter().position(|v| *v <= 0.0) {
+                        return Err(format!(
+                            "{name}: {axis}[{i}] = {} cannot go on a log axis; use positive values (e.g. abs) or log_{axis}: false",
+                            v[i]
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Draw to `path` (SVG or PNG by its extension); folders are created.
+    pub fn save(&self, path: &std::path::Path) -> Result<(), String> {
+        self.validate()?;
+        let format = Format::of(path)?;
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        }
+        render::figure(self, path, format)
+    }
+
+    /// Data range of all series on one axis, after the log transform; padded by 5% (a single
+    /// value gets a unit-wide range).
+    fn range(&self, x_axis: bool) -> (f64, f64) {
+        let log = if x_axis { self.log_x } else { self.log_y };
+        let vals = self
+            .series
+            .iter()
+            .flat_map(|s| if x_axis { &s.x } else { &s.y })
+            .map(|v| if log { v.log10() } else { *v });
+        let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        if hi > lo {
+            let pad = 0.05 * (hi - lo);
+            (lo - pad, hi + pad)
+        } else {
+            let w = if lo == 0.0 { 1.0 } else { 0.05 * lo.abs() };
+            (lo - w, hi + w)
+        }
+    }
+}

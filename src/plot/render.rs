@@ -1,0 +1,275 @@
+//! Drawing with plotters: figures and scene pictures to SVG or PNG.
+
+use super::{Figure, Format, Legend, Style, COLORS};
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// DejaVu Sans, subset to Latin, Greek, super/subscripts and a few signs (assets/fonts).
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
+
+/// Register the embedded font as "sans-serif" once per process.
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The bytes are a valid font (checked by the picture tests); a failure would only leave
+        // text undrawn, never stop a plot.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+fn err(e: impl std::fmt::Debug) -> String {
+    format!("cannot draw the picture: {e:?}")
+}
+
+/// Draw `f` to `path` in `format`.
+pub(super) fn figure(f: &Figure, path: &Path, format: Format) -> Result<(), String> {
+    register_font();
+    match format {
+        Format::Svg => {
+            let root = SVGBackend::new(path, (f.width, f.height)).into_drawing_area();
+            draw_figure(f, &root)?;
+            root.present().map_err(err)
+        }
+        Format::Png => {
+            let root = BitMapBackend::new(path, (f.width, f.height)).into_drawing_area();
+            draw_figure(f, &root)?;
+            root.present().map_err(err)
+        }
+    }
+}
+
+/// A tick label with as many digits as the axis span needs ([`super::format_number`]).
+fn tick(v: f64, span: f64) -> String {
+    super::format_number(v, span)
+}
+
+/// The span a tick at `v` is judged against: the axis range, or on a log axis the value itself
+/// (decades need one digit).
+fn axis_span(range: (f64, f64), log: bool, v: f64) -> f64 {
+    if log {
+        10.0 * v.abs()
+    } else {
+        range.1 - range.0
+    }
+}
+
+fn color(k: usize) -> RGBColor {
+    let (r, g, b) = COLORS[k % COLORS.len()];
+    RGBColor(r, g, b)
+}
+
+fn draw_figure<DB: DrawingBackend>(
+    f: &Figure,
+    root: &DrawingArea<DB, Shift>,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(err)?;
+    // Ranges are padded in the axis's own scale (log10 on a log axis), then mapped back.
+    let axis = |x_axis: bool, log: bool| {
+        let (a, b) = f.range(x_axis);
+        if log {
+            (10f64.powf(a), 10f64.powf(b))
+        } else {
+            (a, b)
+        }
+    };
+    let ((x0, x1), (y0, y1)) = (axis(true, f.log_x), axis(false, f.log_y));
+    match (f.log_x, f.log_y) {
+        (false, false) => draw_in(f, root, x0..x1, y0..y1),
+        (true, false) => draw_in(f, root, (x0..x1).log_scale(), y0..y1),
+        (false, true) => draw_in(f, root, x0..x1, (y0..y1).log_scale()),
+        (true, true) => draw_in(f, root, (x0..x1).log_scale(), (y0..y1).log_scale()),
+    }
+}
+
+fn draw_in<DB, X, Y>(f: &Figure, root: &DrawingArea<DB, Shift>, xr: X, yr: Y) -> Result<(), String>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .margin(14)
+        .x_label_area_size(48)
+        .y_label_area_size(78);
+    if !f.title.is_empty() {
+        builder.caption(&f.title, ("sans-serif", 22));
+    }
+    let mut chart = builder.build_cartesian_2d(xr, yr).map_err(err)?;
+    let (sx, sy) = (f.range(true), f.range(false));
+    let fx = |v: &f64| tick(*v, axis_span(sx, f.log_x, *v));
+    let fy = |v: &f64| tick(*v, axis_span(sy, f.log_y, *v));
+    chart
+        .configure_mesh()
+        .x_desc(f.x_label.as_str())
+        .y_desc(f.y_label.as_str())
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .light_line_style(RGBColor(238, 238, 238))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .draw()
+        .map_err(err)?;
+    for (k, s) in f.series.iter().enumerate() {
+        let c = color(s.color.unwrap_or(k));
+        let pts: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
+        match s.style {
+            Style::Line => {
+                let a = chart
+                    .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                    .map_err(err)?;
+                if !s.label.is_empty() {
+                    a.label(s.label.as_str()).legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(2))
+                    });
+                }
+            }
+            Style::Points => {
+                let a = chart
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, c.filled())))
+                    .map_err(err)?;
+                if !s.label.is_empty() {
+                    a.label(s.label.as_str())
+                        .legend(move |(x, y)| Circle::new((x + 11, y), 4, c.filled()));
+                }
+            }
+        }
+    }
+    let place = match f.legend {
+        Legend::UpperRight => SeriesLabelPosition::UpperRight,
+        Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+        Legend::LowerRight => SeriesLabelPosition::LowerRight,
+        Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
+        Legend::None => return Ok(()),
+    };
+    if f.series.iter().any(|s| !s.label.is_empty()) {
+        chart
+            .configure_series_labels()
+            .position(place)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// A disc of a scene picture in display units (µm): centre, radius, fill colour.
+pub(super) struct Disc {
+    pub x: f64,
+    pub y: f64,
+    pub r: f64,
+    pub fill: RGBColor,
+}
+
+/// A scene picture: rods (pairs of disc indices) under discs, equal scales on both axes.
+pub(super) struct ScenePicture<'a> {
+    pub title: &'a str,
+    pub axes: (&'a str, &'a str),
+    pub size: (u32, u32),
+    pub discs: Vec<Disc>,
+    pub rods: Vec<(usize, usize)>,
+}
+
+/// Draw a scene picture to `path`.
+pub(super) fn scene(p: &ScenePicture, path: &Path, format: Format) -> Result<(), String> {
+    register_font();
+    match format {
+        Format::Svg => {
+            let root = SVGBackend::new(path, p.size).into_drawing_area();
+            draw_scene(p, &root)?;
+            root.present().map_err(err)
+        }
+        Format::Png => {
+            let root = BitMapBackend::new(path, p.size).into_drawing_area();
+            draw_scene(p, &root)?;
+            root.present().map_err(err)
+        }
+    }
+}
+
+fn draw_scene<DB: DrawingBackend>(
+    p: &ScenePicture,
+    root: &DrawingArea<DB, Shift>,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(err)?;
+    let (mut x0, mut x1, mut y0, mut y1) = p.discs.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |(a, b, c, d), s| {
+            (
+                a.min(s.x - s.r),
+                b.max(s.x + s.r),
+                c.min(s.y - s.r),
+                d.max(s.y + s.r),
+            )
+        },
+    );
+    if !(x1 > x0 && y1 > y0) {
+        (x0, x1, y0, y1) = (-1.0, 1.0, -1.0, 1.0);
+    }
+    let pad = 0.05 * (x1 - x0).max(y1 - y0);
+    (x0, x1, y0, y1) = (x0 - pad, x1 + pad, y0 - pad, y1 + pad);
+    // Equal scales: widen the narrower range to the plotting area's aspect ratio.
+    let (caption, xl, yl, margin) = (if p.title.is_empty() { 0 } else { 34 }, 45.0, 70.0, 14.0);
+    let aw = p.size.0 as f64 - yl - 2.0 * margin;
+    let ah = p.size.1 as f64 - xl - 2.0 * margin - caption as f64;
+    let (w, h) = (x1 - x0, y1 - y0);
+    if w / h < aw / ah {
+        let extra = (h * aw / ah - w) / 2.0;
+        (x0, x1) = (x0 - extra, x1 + extra);
+    } else {
+        let extra = (w * ah / aw - h) / 2.0;
+        (y0, y1) = (y0 - extra, y1 + extra);
+    }
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .margin(margin as u32)
+        .x_label_area_size(xl as u32)
+        .y_label_area_size(yl as u32);
+    if !p.title.is_empty() {
+        builder.caption(p.title, ("sans-serif", 20));
+    }
+    let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1).map_err(err)?;
+    let fmt = |v: &f64| tick(*v, (x1 - x0).max(y1 - y0));
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(p.axes.0)
+        .y_desc(p.axes.1)
+        .x_label_formatter(&fmt)
+        .y_label_formatter(&fmt)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    let px = chart.plotting_area().get_pixel_range().0;
+    let px_per_unit = (px.end - px.start) as f64 / (x1 - x0);
+    let grey = RGBColor(90, 90, 90);
+    chart
+        .draw_series(p.rods.iter().map(|&(a, b)| {
+            let (da, db) = (&p.discs[a], &p.discs[b]);
+            PathElement::new(vec![(da.x, da.y), (db.x, db.y)], grey.stroke_width(2))
+        }))
+        .map_err(err)?;
+    for d in &p.discs {
+        let r = ((d.r * px_per_unit).round() as i32).max(1);
+        chart
+            .draw_series([
+                Circle::new((d.x, d.y), r, d.fill.filled()),
+                Circle::new((d.x, d.y), r, BLACK.stroke_width(1)),
+            ])
+            .map_err(err)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,310 @@
+//! Pictures from scripts: `plot` and `tplot` of series, `rec.plot` / `rec.tplot` of recorded
+//! columns, and `s.snapshot` of a scene.
+//!
+//! A series is a map `#{ x: [..], y: [..], label: "..", style: "line" | "points", color: 0-9 }`
+//! (x defaults to 0, 1, 2, ...; color to the series' index in the palette); options are a
+//! map `#{ title, x_label, y_label, log_x, log_y, width, height }` (and `cols`, `rows` for text).
+
+use super::convert::{number, script_error, ScriptResult};
+use super::observable_api::RecorderHandle;
+use super::scene_api::SceneHandle;
+use crate::plot::{render_text, snapshot, Figure, Legend, Plane, Series, SnapshotOptions, Style};
+use rhai::{Array, Dynamic, Engine, Map};
+
+fn numbers(what: &str, v: &Dynamic) -> ScriptResult<Vec<f64>> {
+    let arr = v
+        .clone()
+        .try_cast::<Array>()
+        .ok_or_else(|| script_error(format!("{what} must be an array of numbers, got {v}")))?;
+    arr.iter()
+        .enumerate()
+        .map(|(i, x)| number(&format!("{what}[{i}]"), x))
+        .collect()
+}
+
+fn text(what: &str, v: &Dynamic) -> ScriptResult<String> {
+    v.clone()
+        .into_immutable_string()
+        .map(|s| s.to_string())
+        .map_err(|_| script_error(format!("{what} must be a string, got {v}")))
+}
+
+fn flag(what: &str, v: &Dynamic) -> ScriptResult<bool> {
+    v.as_bool()
+        .map_err(|_| script_error(format!("{what} must be true or false, got {v}")))
+}
+
+fn pixels(what: &str, v: &Dynamic) -> ScriptResult<u32> {
+    let n = number(what, v)?;
+    if n.fract() != 0.0 || !(1.0..=1e5).contains(&n) {
+        return Err(script_error(format!(
+            "{what} must be a whole number of pixels, got {v}"
+        )));
+    }
+    Ok(n as u32)
+}
+
+fn series_of(k: usize, m: &Map) -> ScriptResult<Series> {
+    let mut s = Series {
+        label: String::new(),
+        x: Vec::new(),
+        y: Vec::new(),
+        style: Style::Line,
+        color: None,
+    };
+    let (mut has_x, mut has_y) = (false, false);
+    for (key, v) in m {
+        match key.as_str() {
+            "x" => (s.x, has_x) = (numbers(&format!("series {k}: x"), v)?, true),
+            "y" => (s.y, has_y) = (numbers(&format!("series {k}: y"), v)?, true),
+            "label" => s.label = text("label", v)?,
+            "color" => {
+                let c = v.as_int().map_err(|_| {
+                    script_error(format!(
+                        "series {k}: color must be a palette index 0-9, got {v}"
+                    ))
+                })?;
+                s.color = Some(c.rem_euclid(crate::plot::COLORS.len() as rhai::INT) as usize);
+            }
+            "style" => {
+                s.style = Style::parse(&text("style", v)?)
+                    .map_err(|e| script_error(format!("series {k}: {e}")))?
+            }
+            other => {
+                return Err(script_error(format!(
+                    "series {k}: unknown key \"{other}\"; use x, y, label, style, color"
+                )))
+            }
+        }
+    }
+    if !has_y {
+        return Err(script_error(format!(
+            "series {k} has no y; a series is #{{ x: [..], y: [..], label: \"..\" }}"
+        )));
+    }
+    if !has_x {
+        s.x = (0..s.y.len()).map(|i| i as f64).collect();
+    }
+    Ok(s)
+}
+
+/// One map or an array of maps.
+fn all_series(v: &Dynamic) -> ScriptResult<Vec<Series>> {
+    if let Some(m) = v.clone().try_cast::<Map>() {
+        return Ok(vec![series_of(0, &m)?]);
+    }
+    let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
+        script_error(format!(
+            "plot series must be a map #{{ x: [..], y: [..] }} or an array of them, got {v}"
+        ))
+    })?;
+    arr.iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let m = s.clone().try_cast::<Map>().ok_or_else(|| {
+                script_error(format!(
+                    "series {k} must be a map #{{ x: [..], y: [..] }}, got {s}"
+                ))
+            })?;
+            series_of(k, &m)
+        })
+        .collect()
+}
+
+/// Text plot size from the options.
+struct TextSize(usize, usize);
+
+fn apply_options(f: &mut Figure, opts: &Map) -> ScriptResult<TextSize> {
+    let mut size = TextSize(72, 18);
+    for (key, v) in opts {
+        match key.as_str() {
+            "title" => f.title = text("title", v)?,
+            "x_label" => f.x_label = text("x_label", v)?,
+            "y_label" => f.y_label = text("y_label", v)?,
+            "log_x" => f.log_x = flag("log_x", v)?,
+            "log_y" => f.log_y = flag("log_y", v)?,
+            "width" => f.width = pixels("width", v)?,
+            "height" => f.height = pixels("height", v)?,
+            "legend" => {
+                f.legend = Legend::parse(&text("legend", v)?).map_err(script_error)?
+            }
+            "cols" => size.0 = pixels("cols", v)? as usize,
+            "rows" => size.1 = pixels("rows", v)? as usize,
+            other => {
+                return Err(script_error(format!(
+                    "unknown plot option \"{other}\"; use title, x_label, y_label, log_x, log_y, width, height, legend (cols, rows for tplot)"
+                )))
+            }
+        }
+    }
+    Ok(size)
+}
+
+fn save(f: &Figure, path: &str) -> ScriptResult<()> {
+    f.save(std::path::Path::new(path))
+        .map_err(|e| script_error(format!("plot \"{path}\": {e}")))
+}
+
+fn show(f: &Figure, size: TextSize) -> ScriptResult<()> {
+    let t = render_text(f, size.0, size.1).map_err(|e| script_error(format!("tplot: {e}")))?;
+    print!("{t}");
+    Ok(())
+}
+
+fn plot(path: &str, series: &Dynamic, opts: &Map) -> ScriptResult<()> {
+    let mut f = Figure {
+        series: all_series(series)?,
+        ..Figure::default()
+    };
+    apply_options(&mut f, opts)?;
+    save(&f, path)
+}
+
+fn tplot(series: &Dynamic, opts: &Map) -> ScriptResult<()> {
+    let mut f = Figure {
+        series: all_series(series)?,
+        ..Figure::default()
+    };
+    let size = apply_options(&mut f, opts)?;
+    show(&f, size)
+}
+
+/// Columns `x` and `ys` of a recorder as a figure, labelled with the header's units.
+fn recorder_figure(r: &RecorderHandle, x: &str, ys: &Dynamic) -> ScriptResult<Figure> {
+    let names: Vec<String> = if let Ok(s) = ys.clone().into_immutable_string() {
+        vec![s.to_string()]
+    } else {
+        let arr = ys.clone().try_cast::<Array>().ok_or_else(|| {
+            script_error(format!(
+                "y columns must be a name or an array of names, got {ys}"
+            ))
+        })?;
+        arr.iter()
+            .map(|v| text("y column", v))
+            .collect::<ScriptResult<_>>()?
+    };
+    r.with(|rec| {
+        let cols = rec.columns();
+        let header = rec.header();
+        let find = |name: &str| {
+            cols.iter().position(|c| c == name).ok_or_else(|| {
+                script_error(format!(
+                    "the recorder has no column \"{name}\"; it has {}",
+                    cols.join(", ")
+                ))
+            })
+        };
+        let column = |i: usize| rec.rows.iter().map(|row| row[i]).collect::<Vec<f64>>();
+        let xi = find(x)?;
+        let series = names
+            .iter()
+            .map(|n| {
+                let i = find(n)?;
+                Ok(Series {
+                    label: header[i].clone(),
+                    x: column(xi),
+                    y: column(i),
+                    style: Style::Line,
+                    color: None,
+                })
+            })
+            .collect::<ScriptResult<Vec<_>>>()?;
+        let y_label = if names.len() == 1 {
+            header[find(&names[0])?].clone()
+        } else {
+            String::new()
+        };
+        Ok(Figure {
+            x_label: header[xi].clone(),
+            y_label,
+            series,
+            ..Figure::default()
+        })
+    })?
+}
+
+fn snapshot_options(opts: &Map) -> ScriptResult<SnapshotOptions> {
+    let mut o = SnapshotOptions::default();
+    for (key, v) in opts {
+        match key.as_str() {
+            "plane" => {
+                o.plane = Plane::parse(&text("plane", v)?)
+                    .map_err(|e| script_error(format!("snapshot: {e}")))?
+            }
+            "title" => o.title = text("title", v)?,
+            "width" => o.width = pixels("width", v)?,
+            "height" => o.height = pixels("height", v)?,
+            other => {
+                return Err(script_error(format!(
+                    "unknown snapshot option \"{other}\"; use plane, title, width, height"
+                )))
+            }
+        }
+    }
+    Ok(o)
+}
+
+/// Register the picture functions.
+pub fn register(engine: &mut Engine) {
+    engine
+        .register_fn("plot", |path: &str, series: Dynamic| {
+            plot(path, &series, &Map::new())
+        })
+        .register_fn("plot", |path: &str, series: Dynamic, opts: Map| {
+            plot(path, &series, &opts)
+        })
+        .register_fn("tplot", |series: Dynamic| tplot(&series, &Map::new()))
+        .register_fn("tplot", |series: Dynamic, opts: Map| tplot(&series, &opts))
+        .register_fn(
+            "plot",
+            |r: &mut RecorderHandle, path: &str, x: &str, ys: Dynamic| -> ScriptResult<()> {
+                save(&recorder_figure(r, x, &ys)?, path)
+            },
+        )
+        .register_fn(
+            "plot",
+            |r: &mut RecorderHandle,
+             path: &str,
+             x: &str,
+             ys: Dynamic,
+             opts: Map|
+             -> ScriptResult<()> {
+                let mut f = recorder_figure(r, x, &ys)?;
+                apply_options(&mut f, &opts)?;
+                save(&f, path)
+            },
+        )
+        .register_fn(
+            "tplot",
+            |r: &mut RecorderHandle, x: &str, ys: Dynamic| -> ScriptResult<()> {
+                show(&recorder_figure(r, x, &ys)?, TextSize(72, 18))
+            },
+        )
+        .register_fn(
+            "tplot",
+            |r: &mut RecorderHandle, x: &str, ys: Dynamic, opts: Map| -> ScriptResult<()> {
+                let mut f = recorder_figure(r, x, &ys)?;
+                let size = apply_options(&mut f, &opts)?;
+                show(&f, size)
+            },
+        )
+        .register_fn(
+            "snapshot",
+            |s: &mut SceneHandle, path: &str| -> ScriptResult<()> {
+                snapshot(
+                    &s.borrow(),
+                    &SnapshotOptions::default(),
+                    std::path::Path::new(path),
+                )
+                .map_err(|e| script_error(format!("snapshot \"{path}\": {e}")))
+            },
+        )
+        .register_fn(
+            "snapshot",
+            |s: &mut SceneHandle, path: &str, opts: Map| -> ScriptResult<()> {
+                let o = snapshot_options(&opts)?;
+                snapshot(&s.borrow(), &o, std::path::Path::new(path))
+                    .map_err(|e| script_error(format!("snapshot \"{path}\": {e}")))
+            },
+        );
+}
