@@ -65,6 +65,7 @@ fn draw_figure<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(err)?;
+    let f = &f.with_offsets();
     // Ranges are padded in the axis's own scale (log10 on a log axis), then mapped back.
     let axis = |x_axis: bool, log: bool| {
         let (a, b) = f.range(x_axis);

@@ -9,6 +9,7 @@ const MARKS: [char; 6] = ['*', 'o', '+', 'x', '#', '@'];
 /// The figure as text `cols` wide and `rows` high (plot area), log axes honoured.
 pub fn render_text(f: &Figure, cols: usize, rows: usize) -> Result<String, String> {
     f.validate()?;
+    let f = &f.with_offsets();
     let (cols, rows) = (cols.clamp(10, 400), rows.clamp(4, 200));
     let (x0, x1) = f.range(true);
     let (y0, y1) = f.range(false);
