@@ -256,7 +256,7 @@ impl Figure {
             let log = if x_axis { f.log_x } else { f.log_y };
             let (lo, hi) = f.range(x_axis);
             let (center, span) = ((lo + hi) / 2.0, hi - lo);
-            if log || !(span > 0.0) || center.abs() < 1e3 * span {
+            if log || span.is_nan() || span <= 0.0 || center.abs() < 1e3 * span {
                 continue;
             }
             let step = 10f64.powf(span.log10().floor());
