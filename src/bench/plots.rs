@@ -30,29 +30,21 @@ pub fn work_precision(points: &[Point], config: &str) -> Option<Figure> {
         .into_iter()
         .map(|(label, mut pts)| {
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            Series {
-                label,
-                x: pts.iter().map(|p| p.0).collect(),
-                y: pts.iter().map(|p| p.1).collect(),
-                style: if pts.len() > 1 {
-                    Style::Line
-                } else {
-                    Style::Points
-                },
-                color: None,
-            }
+            let style = if pts.len() > 1 {
+                Style::Line
+            } else {
+                Style::Points
+            };
+            Series::from_points(label, &pts, style, None)
         })
         .collect();
-    Some(Figure {
-        title: format!("work against precision: {config}"),
-        x_label: "relative error of the drift".into(),
-        y_label: "wall time [s]".into(),
-        log_x: true,
-        log_y: true,
+    Some(log_log(
+        format!("work against precision: {config}"),
+        "relative error of the drift",
+        "wall time [s]",
         series,
-        legend: Legend::UpperRight,
-        ..Figure::default()
-    })
+        Legend::UpperRight,
+    ))
 }
 
 /// Seconds per RK4 step against size, CPU and GPU, both models.
@@ -66,26 +58,18 @@ pub fn backends(rows: &[BackendRow]) -> Figure {
                 .filter_map(|r| Some((r.size as f64, if gpu { r.gpu? } else { r.cpu? })))
                 .collect();
             if !pts.is_empty() {
-                series.push(Series {
-                    label: format!("{} {name}", model.name()),
-                    x: pts.iter().map(|p| p.0).collect(),
-                    y: pts.iter().map(|p| p.1).collect(),
-                    style: Style::Line,
-                    color: None,
-                });
+                let label = format!("{} {name}", model.name());
+                series.push(Series::from_points(label, &pts, Style::Line, None));
             }
         }
     }
-    Figure {
-        title: "time per RK4 step, CPU and GPU".into(),
-        x_label: "spheres (micro) or swimmers (averaged)".into(),
-        y_label: "wall time per step [s]".into(),
-        log_x: true,
-        log_y: true,
+    log_log(
+        "time per RK4 step, CPU and GPU".into(),
+        "spheres (micro) or swimmers (averaged)",
+        "wall time per step [s]",
         series,
-        legend: Legend::UpperLeft,
-        ..Figure::default()
-    }
+        Legend::UpperLeft,
+    )
 }
 
 /// Cost per period against the number of swimmers, both models, with the fitted power laws.
@@ -96,32 +80,50 @@ pub fn scaling(rows: &[ScalingRow]) -> Figure {
         if mine.is_empty() {
             continue;
         }
-        series.push(Series {
-            label: model.name().into(),
-            x: mine.iter().map(|r| r.swimmers as f64).collect(),
-            y: mine.iter().map(|r| r.per_period()).collect(),
-            style: Style::Points,
-            color: Some(k),
-        });
+        let measured: Vec<(f64, f64)> = mine
+            .iter()
+            .map(|r| (r.swimmers as f64, r.per_period()))
+            .collect();
+        series.push(Series::from_points(
+            model.name(),
+            &measured,
+            Style::Points,
+            Some(k),
+        ));
         if let Some((slope, c)) = scaling::fit(rows, model, 256) {
-            let xs: Vec<f64> = mine.iter().map(|r| r.swimmers as f64).collect();
-            series.push(Series {
-                label: format!("{c:.2e} S^{slope:.2} (fit, S >= 256)"),
-                y: xs.iter().map(|x| c * x.powf(slope)).collect(),
-                x: xs,
-                style: Style::Line,
-                color: Some(k),
-            });
+            let fitted: Vec<(f64, f64)> = measured
+                .iter()
+                .map(|&(x, _)| (x, c * x.powf(slope)))
+                .collect();
+            let label = format!("{c:.2e} S^{slope:.2} (fit, S >= 256)");
+            series.push(Series::from_points(label, &fitted, Style::Line, Some(k)));
         }
     }
+    log_log(
+        "cost per stroke period on the CPU".into(),
+        "swimmers S",
+        "wall time per period [s]",
+        series,
+        Legend::UpperLeft,
+    )
+}
+
+/// A figure with both axes logarithmic.
+fn log_log(
+    title: String,
+    x_label: &str,
+    y_label: &str,
+    series: Vec<Series>,
+    legend: Legend,
+) -> Figure {
     Figure {
-        title: "cost per stroke period on the CPU".into(),
-        x_label: "swimmers S".into(),
-        y_label: "wall time per period [s]".into(),
+        title,
+        x_label: x_label.into(),
+        y_label: y_label.into(),
         log_x: true,
         log_y: true,
         series,
-        legend: Legend::UpperLeft,
+        legend,
         ..Figure::default()
     }
 }

@@ -10,10 +10,11 @@
 //! What a scene does not need is skipped: pairs with sin(φσ−φρ) = 0, the I and K terms of symmetric
 //! swimmers, and for an aligned scene the 3D algebra (the 1D reduction e:stroke_averaged).
 
-use super::contacts::{Contacts, Steric};
+use super::contacts::Contacts;
 use super::integrators::{OdeSystem, Problem};
 use super::mobility::self_mobility;
 use super::model::{set_vec3, vec3, Coefficients, STATE_PER_SWIMMER};
+use super::pairs::SoaSpheres;
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -148,8 +149,16 @@ pub struct AveragedSystem {
     scale_r: Vec<f64>,
     scale_n: Vec<f64>,
     skip_symmetric: bool,
-    /// Radii (a1, a2) and the weights (w1, w2) placing the spheres about R_H.
-    spheres: Vec<[f64; 4]>,
+    /// The weights (w1, w2) placing each swimmer's spheres about R_H.
+    weights: Vec<(f64, f64)>,
+    /// Sphere radii, sphere 2σ being σ's a1 sphere (the sphere models' numbering).
+    radii: Vec<f64>,
+    /// Sphere centres at length ℓ, filled with the arrays (contact guard and steric repulsion).
+    sphere_pos: Vec<Vector3<f64>>,
+    /// Steric force on every sphere (scratch; empty without the repulsion).
+    steric_f: Vec<Vector3<f64>>,
+    /// Sphere centres for the contact guard's minimum-gap pass (scratch).
+    gap_soa: SoaSpheres,
     contacts: Contacts,
     mu: f64,
 }
@@ -198,10 +207,11 @@ impl AveragedSystem {
             cutoff2: f64::INFINITY,
             axis: None,
             skip_symmetric: shortcuts.skip_symmetric_terms,
-            spheres: swimmers
-                .iter()
-                .map(|d| [d.a1, d.a2, d.w1(), d.w2()])
-                .collect(),
+            weights: swimmers.iter().map(|d| (d.w1(), d.w2())).collect(),
+            radii: swimmers.iter().flat_map(|d| [d.a1, d.a2]).collect(),
+            sphere_pos: vec![Vector3::zeros(); 2 * n],
+            steric_f: Vec::new(),
+            gap_soa: SoaSpheres::default(),
             contacts: Contacts::default(),
             mu: super::scene::DEFAULT_MU,
         };
@@ -220,58 +230,23 @@ impl AveragedSystem {
     pub fn set_contacts(&mut self, contacts: Contacts, mu: f64) {
         self.contacts = contacts;
         self.mu = mu;
+        self.steric_f = match contacts.steric {
+            Some(_) => vec![Vector3::zeros(); self.radii.len()],
+            None => Vec::new(),
+        };
         if contacts.steric.is_some() {
             // The 1D reduction has no sphere geometry.
             self.axis = None;
         }
     }
 
-    /// The two sphere centres of swimmer σ (length ℓ), from the arrays.
-    #[inline]
-    fn sphere_centres(&self, s: usize) -> [Vector3<f64>; 2] {
-        let soa = &self.soa;
-        let c = Vector3::new(soa.x[s], soa.y[s], soa.z[s]);
-        let b = Vector3::new(soa.nx[s], soa.ny[s], soa.nz[s]) * self.coef[s].ell;
-        let [_, _, w1, w2] = self.spheres[s];
-        [c - w2 * b, c + w1 * b]
-    }
-
-    /// The smallest surface gap between a sphere of σ and one of ρ, with the spheres (k, m).
-    fn closest_spheres(&self, s: usize, r: usize) -> (f64, usize, usize) {
-        let (ps, pr) = (self.sphere_centres(s), self.sphere_centres(r));
-        let mut best = (f64::INFINITY, 0, 0);
-        for k in 0..2 {
-            for m in 0..2 {
-                let gap = (ps[k] - pr[m]).norm() - self.spheres[s][k] - self.spheres[r][m];
-                if gap < best.0 {
-                    best = (gap, k, m);
-                }
-            }
-        }
-        best
-    }
-
-    /// The steric rates (dR_H/dt, dN/dt) of swimmer σ.
-    fn steric_rates(&self, st: &Steric, s: usize) -> (Vector3<f64>, Vector3<f64>) {
-        let ps = self.sphere_centres(s);
-        let mut f = [Vector3::zeros(); 2];
-        for r in (0..self.coef.len()).filter(|&r| r != s) {
-            let pr = self.sphere_centres(r);
-            for k in 0..2 {
-                for m in 0..2 {
-                    let d = ps[k] - pr[m];
-                    let dist = d.norm();
-                    let gap = dist - self.spheres[s][k] - self.spheres[r][m];
-                    if gap < st.range && dist > 0.0 {
-                        f[k] += d * (st.stiffness * (st.range - gap) / dist);
-                    }
-                }
-            }
-        }
-        let [a1, a2, _, _] = self.spheres[s];
-        let v = (f[0] + f[1]) * self_mobility(self.mu, a1 + a2);
-        let rel = (f[1] * self_mobility(self.mu, a2) - f[0] * self_mobility(self.mu, a1))
-            / self.coef[s].ell;
+    /// The steric rates (dR_H/dt, dN/dt) of swimmer σ from the forces on its spheres.
+    fn steric_rates(&self, s: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let (f1, f2) = (self.steric_f[2 * s], self.steric_f[2 * s + 1]);
+        let (a1, a2) = (self.radii[2 * s], self.radii[2 * s + 1]);
+        let v = (f1 + f2) * self_mobility(self.mu, a1 + a2);
+        let rel =
+            (f2 * self_mobility(self.mu, a2) - f1 * self_mobility(self.mu, a1)) / self.coef[s].ell;
         let n = Vector3::new(self.soa.nx[s], self.soa.ny[s], self.soa.nz[s]);
         (v, rel - n * n.dot(&rel))
     }
@@ -321,7 +296,7 @@ impl AveragedSystem {
             .then_some(axis)
     }
 
-    /// Fill the structure of arrays from the state `y`.
+    /// Fill the structure of arrays and the sphere centres (length ℓ) from the state `y`.
     fn fill(&mut self, y: &[f64]) {
         for s in 0..self.coef.len() {
             let c = self.center(y, s);
@@ -329,6 +304,10 @@ impl AveragedSystem {
             let soa = &mut self.soa;
             (soa.x[s], soa.y[s], soa.z[s]) = (c.x, c.y, c.z);
             (soa.nx[s], soa.ny[s], soa.nz[s]) = (n.x, n.y, n.z);
+            let b = n * self.coef[s].ell;
+            let (w1, w2) = self.weights[s];
+            self.sphere_pos[2 * s] = c - w2 * b;
+            self.sphere_pos[2 * s + 1] = c + w1 * b;
         }
     }
 
@@ -436,8 +415,8 @@ impl AveragedSystem {
             let (mut v, t) = self.row(s);
             let n = vec3(y, STATE_PER_SWIMMER * s + 3);
             let mut dn = -(t - n * n.dot(&t));
-            if let Some(st) = &self.contacts.steric {
-                let (vs, ns) = self.steric_rates(st, s);
+            if self.contacts.steric.is_some() {
+                let (vs, ns) = self.steric_rates(s);
                 v += vs;
                 dn += ns;
             }
@@ -472,6 +451,12 @@ impl OdeSystem for AveragedSystem {
             }
             None => self.fill(y),
         }
+        if let Some(st) = self.contacts.steric {
+            // The sphere models' pair force, on the spheres at length ℓ.
+            self.steric_f.fill(Vector3::zeros());
+            let parallel = self.coef.len() >= PARALLEL_SWIMMERS;
+            st.add_forces(&self.sphere_pos, &self.radii, &mut self.steric_f, parallel);
+        }
         self.rows_into(y, dy);
     }
 
@@ -489,33 +474,41 @@ impl OdeSystem for AveragedSystem {
         self.fill(y);
         let soa = &self.soa;
         let n = self.coef.len();
-        let guard = !self.contacts.allow_overlap;
-        // The first problem of row σ: a shared centre, or (unless allowed) touching spheres.
-        let row = |s: usize| {
-            (s + 1..n).find_map(|r| {
-                if soa.x[s] == soa.x[r] && soa.y[s] == soa.y[r] && soa.z[s] == soa.z[r] {
-                    return self.pair_sin(s, r).is_some().then(|| Problem {
-                        swimmer: Some(s),
-                        cause: format!("swimmers {s} and {r} have the same centre"),
-                        hint: "start the swimmers apart: the averaged model is a far-field model"
-                            .into(),
-                    });
-                }
-                if !guard {
-                    return None;
-                }
-                let (gap, k, m) = self.closest_spheres(s, r);
-                (gap <= 0.0).then(|| super::spheres::overlap_problem(gap, 2 * s + k, 2 * r + m))
-            })
+        let parallel = n >= PARALLEL_SWIMMERS;
+        let shared_centre = |s: usize| {
+            (s + 1..n)
+                .find(|&r| {
+                    soa.x[s] == soa.x[r]
+                        && soa.y[s] == soa.y[r]
+                        && soa.z[s] == soa.z[r]
+                        && self.pair_sin(s, r).is_some()
+                })
+                .map(|r| (s, r))
         };
-        let found = if n >= PARALLEL_SWIMMERS {
-            (0..n).into_par_iter().find_map_first(row)
+        let found = if parallel {
+            (0..n).into_par_iter().find_map_first(shared_centre)
         } else {
-            (0..n).find_map(row)
+            (0..n).find_map(shared_centre)
         };
-        match found {
-            Some(p) => Err(p),
-            None => Ok(()),
+        if let Some((s, r)) = found {
+            return Err(Problem {
+                swimmer: Some(s),
+                cause: format!("swimmers {s} and {r} have the same centre"),
+                hint: "start the swimmers apart: the averaged model is a far-field model".into(),
+            });
+        }
+        if self.contacts.allow_overlap {
+            return Ok(());
+        }
+        // The sphere models' contact guard, on the spheres at length ℓ.
+        let g = &mut self.gap_soa;
+        g.resize(self.sphere_pos.len());
+        for (i, p) in self.sphere_pos.iter().enumerate() {
+            (g.x[i], g.y[i], g.z[i]) = (p.x, p.y, p.z);
+        }
+        match super::pairs::min_gap(g, &self.radii, parallel) {
+            Some((gap, a, b)) if gap <= 0.0 => Err(super::spheres::overlap_problem(gap, a, b)),
+            _ => Ok(()),
         }
     }
 

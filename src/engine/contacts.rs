@@ -63,10 +63,12 @@ impl Steric {
                     continue;
                 }
                 let r = pos[i] - pj;
-                let d = r.norm();
-                let gap = d - radii[i] - aj;
-                if gap < self.range && d > 0.0 {
-                    *f += r * (self.stiffness * (self.range - gap) / d);
+                // Compare squares first: the square root is taken for the few close pairs only.
+                let reach = self.range + radii[i] + aj;
+                let d2 = r.norm_squared();
+                if d2 < reach * reach && d2 > 0.0 {
+                    let d = d2.sqrt();
+                    *f += r * (self.stiffness * (reach - d) / d);
                 }
             }
         };

@@ -50,6 +50,24 @@ pub struct Series {
     pub color: Option<usize>,
 }
 
+impl Series {
+    /// A series of (x, y) points.
+    pub fn from_points(
+        label: impl Into<String>,
+        pts: &[(f64, f64)],
+        style: Style,
+        color: Option<usize>,
+    ) -> Self {
+        Series {
+            label: label.into(),
+            x: pts.iter().map(|p| p.0).collect(),
+            y: pts.iter().map(|p| p.1).collect(),
+            style,
+            color,
+        }
+    }
+}
+
 /// A plot: axes with labels (units included by the caller), optional log scales, and series.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {

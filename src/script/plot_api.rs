@@ -151,21 +151,22 @@ fn show(f: &Figure, size: TextSize) -> ScriptResult<()> {
     Ok(())
 }
 
-fn plot(path: &str, series: &Dynamic, opts: &Map) -> ScriptResult<()> {
-    let mut f = Figure {
-        series: all_series(series)?,
-        ..Figure::default()
-    };
-    apply_options(&mut f, opts)?;
-    save(&f, path)
-}
-
-fn tplot(series: &Dynamic, opts: &Map) -> ScriptResult<()> {
+/// The figure of `series` with `opts` applied, and the text plot size.
+fn figure_of(series: &Dynamic, opts: &Map) -> ScriptResult<(Figure, TextSize)> {
     let mut f = Figure {
         series: all_series(series)?,
         ..Figure::default()
     };
     let size = apply_options(&mut f, opts)?;
+    Ok((f, size))
+}
+
+fn plot(path: &str, series: &Dynamic, opts: &Map) -> ScriptResult<()> {
+    save(&figure_of(series, opts)?.0, path)
+}
+
+fn tplot(series: &Dynamic, opts: &Map) -> ScriptResult<()> {
+    let (f, size) = figure_of(series, opts)?;
     show(&f, size)
 }
 
