@@ -276,47 +276,38 @@ fn make_figures(quick: bool, out: Option<&std::path::Path>) -> Result<(), String
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let mut scope = Scope::new();
     let result = if let Some(expr) = cli.eval {
-        let engine = swimlab::script::engine();
-        match engine.eval_with_scope::<Dynamic>(&mut scope, &expr) {
-            Ok(v) => {
-                if !v.is_unit() {
-                    println!("{}", swimlab::script::show(&v));
-                }
-                Ok(())
+        swimlab::script::interrupt::install_batch_handler();
+        swimlab::script::eval_expression(&expr).map(|shown| {
+            if let Some(v) = shown {
+                println!("{v}");
             }
-            Err(e) => Err(swimlab::script::render_error("-e", &expr, &e)),
-        }
+        })
     } else {
         match cli.command {
             Some(Command::Bench { which, quick }) => bench(which, quick),
-            Some(Command::MakeFigures { quick, out }) => make_figures(quick, out.as_deref()),
+            Some(Command::MakeFigures { quick, out }) => {
+                swimlab::script::interrupt::install_batch_handler();
+                make_figures(quick, out.as_deref())
+            }
             Some(Command::Run { file, quick, set }) => {
+                swimlab::script::interrupt::install_batch_handler();
                 if quick {
                     // Read by `quick()` in scripts; set before any other thread exists.
                     std::env::set_var("SWIMLAB_QUICK", "1");
                 }
-                let mut res = Ok(());
-                for item in &set {
-                    match parse_set(item) {
-                        Ok((name, v)) => {
-                            scope.push_constant_dynamic(name, v);
-                        }
-                        Err(e) => {
-                            res = Err(format!("{e}\n"));
-                            break;
-                        }
-                    }
-                }
-                res.and_then(|()| match file {
-                    Some(path) => swimlab::script::run_file(&path, &mut scope),
-                    None => swimlab::script::run_source(
-                        "scripts/pair.rhai (built in)",
-                        DEFAULT_SCRIPT,
-                        &mut scope,
-                    ),
-                })
+                set.iter()
+                    .map(|item| parse_set(item))
+                    .collect::<Result<Vec<_>, String>>()
+                    .map_err(|e| format!("{e}\n"))
+                    .and_then(|sets| match file {
+                        Some(path) => swimlab::script::run_file_with(&path, &sets),
+                        None => swimlab::script::run_source_with(
+                            "scripts/pair.rhai (built in)",
+                            DEFAULT_SCRIPT,
+                            &sets,
+                        ),
+                    })
             }
             None => {
                 return if swimlab::repl::run() {
@@ -331,7 +322,13 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(msg) => {
             eprint!("{msg}");
-            ExitCode::FAILURE
+            if swimlab::script::interrupt::requested() {
+                eprintln!("swimlab: stopped by Ctrl-C (SIGINT); rows streamed to files are complete up to that point");
+                // The shell convention for a process ended by SIGINT.
+                ExitCode::from(130)
+            } else {
+                ExitCode::FAILURE
+            }
         }
     }
 }

@@ -100,12 +100,17 @@ fn load_clear_and_quit() {
 fn piped_input_runs_line_by_line_and_reports_failure() {
     let input =
         "let s = scene();\nfn f(x) {\n  x * 2\n}\nf(21)\ns.mobility = \"stokes\";\ns.mobility\n";
-    let mut buf = Vec::new();
-    let ok = piped(input.as_bytes(), &mut buf);
+    let (mut buf, mut errs) = (Vec::new(), Vec::new());
+    let ok = piped(input.as_bytes(), &mut buf, &mut errs);
     let text = String::from_utf8(buf).unwrap();
+    let errors = String::from_utf8(errs).unwrap();
     assert!(!ok, "an error makes the piped session fail");
     assert!(text.contains("=> 42"), "{text}");
-    assert!(text.contains("unknown mobility"), "{text}");
+    assert!(
+        errors.contains("unknown mobility"),
+        "errors go to stderr: {errors}"
+    );
+    assert!(!text.contains("unknown mobility"), "not to stdout: {text}");
     assert!(
         text.contains("=> \"rpy\""),
         "the session went on after the error: {text}"

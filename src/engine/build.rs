@@ -58,6 +58,10 @@ pub enum Phases {
     Equal(f64),
 }
 
+/// Most swimmers one random placement may place: it tests each new swimmer against every placed
+/// one, so 50,000 swimmers take ~5e9 distance checks (seconds); more would run for minutes.
+pub const MAX_RANDOM_SWIMMERS: usize = 50_000;
+
 /// The side (m) of the cube holding `n` copies of `d` at sphere volume fraction `phi`.
 pub fn box_side(n: usize, d: &Dumbbell, phi: f64) -> Result<f64> {
     require_positive("volume fraction", phi, "dimensionless")?;
@@ -83,6 +87,11 @@ pub fn random_suspension(
     seed: u64,
 ) -> Result<()> {
     require_positive("box side", side, "m")?;
+    if n > MAX_RANDOM_SWIMMERS {
+        return Err(invalid!(
+            "cannot place {n} swimmers at random in one call: placement checks every new swimmer against all placed ones (n^2/2 checks), so one call places at most {MAX_RANDOM_SWIMMERS}; place a lattice with s.add_at(d, lattice::cubic(...)) for more"
+        ));
+    }
     // Over a stroke a sphere moves by w·2λ along its axis (w = a_other/(a1+a2)): two spheres
     // placed further apart than 4λ·max(w1, w2) cannot be brought into contact by the strokes.
     let margin = 4.0 * d.lambda * d.w1().max(d.w2());

@@ -9,6 +9,7 @@ pub mod backend;
 pub mod build;
 pub mod contacts;
 pub mod error;
+pub mod files;
 pub mod gpu;
 pub mod integrators;
 pub mod micro;

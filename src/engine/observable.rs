@@ -248,20 +248,7 @@ impl Observable {
 
     /// The smallest sphere gap of the scene (m); +inf with fewer than two spheres.
     fn min_gap(s: &Scene) -> f64 {
-        let n = 2 * s.count();
-        let mut soa = super::pairs::SoaSpheres::default();
-        soa.resize(n);
-        let mut radii = Vec::with_capacity(n);
-        for i in 0..s.count() {
-            let (a, b) = s.spheres(i);
-            let d = &s.swimmers()[i];
-            for (k, (p, r)) in [(a, d.a1), (b, d.a2)].into_iter().enumerate() {
-                let j = 2 * i + k;
-                (soa.x[j], soa.y[j], soa.z[j]) = (p.x, p.y, p.z);
-                radii.push(r);
-            }
-        }
-        super::pairs::min_gap(&soa, &radii, n >= 256).map_or(f64::INFINITY, |g| g.0)
+        s.closest_spheres().map_or(f64::INFINITY, |g| g.0)
     }
 
     /// Value of `obs` now and one period later, on a copy of the scene (the scene is not changed).

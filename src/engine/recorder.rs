@@ -2,6 +2,7 @@
 //! observables only at its trigger's times, never between them, and keeps the rows.
 
 use super::error::{invalid, require_positive, Result};
+use super::files::{write_atomically, LineStream};
 use super::observable::Observable;
 use super::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -40,7 +41,8 @@ impl Trigger {
     /// Human-readable form.
     pub fn describe(&self) -> String {
         match self {
-            Trigger::EveryPeriods(n) => format!("every {n} periods"),
+            Trigger::EveryPeriods(n) if (1e-3..1e6).contains(n) => format!("every {n} periods"),
+            Trigger::EveryPeriods(n) => format!("every {n:e} periods"),
             Trigger::EverySeconds(t) => format!("every {t:e} s"),
             Trigger::AtTimes(ts) => format!("at {} given times", ts.len()),
             Trigger::AtEnd => "at the end of each run".into(),
@@ -48,8 +50,17 @@ impl Trigger {
     }
 }
 
+/// Most rows one run may add to one recorder. Rows are kept in memory (and `rec.rows` turns them
+/// into script maps), so a trigger far finer than the run needs is refused before the run starts,
+/// with the numbers; a longer recording is split into several runs.
+pub const MAX_ROWS_PER_RUN: f64 = 1e7;
+
+/// The finest interval a periodic trigger may have, relative to the times it is used at: below
+/// this, consecutive due times can no longer be told apart in f64.
+pub const MIN_RELATIVE_INTERVAL: f64 = 1e-12;
+
 /// A recorder: observables, a trigger, and the rows taken so far.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Recorder {
     /// What is recorded.
     pub observables: Vec<Observable>,
@@ -63,6 +74,8 @@ pub struct Recorder {
     next_k: u64,
     /// Rows: time, then every observable's components in order.
     pub rows: Vec<Vec<f64>>,
+    /// Where each new row is also appended as CSV, if anywhere.
+    stream: Option<LineStream>,
 }
 
 impl Recorder {
@@ -77,6 +90,16 @@ impl Recorder {
             Trigger::EverySeconds(t) => Some(*t),
             _ => None,
         };
+        if let Some(dt) = interval {
+            let floor = MIN_RELATIVE_INTERVAL * scene.time().abs();
+            if !(dt > floor && dt > 0.0) {
+                return Err(invalid!(
+                    "a recorder {} (an interval of {dt:e} s) cannot be resolved at t = {:e} s: f64 tells times apart only down to ~{floor:e} s there; record less often",
+                    trigger.describe(),
+                    scene.time()
+                ));
+            }
+        }
         let mut r = Recorder {
             observables,
             trigger,
@@ -84,6 +107,7 @@ impl Recorder {
             interval,
             next_k: 0,
             rows: Vec::new(),
+            stream: None,
         };
         if r.interval.is_some() {
             r.take(scene)?;
@@ -141,10 +165,43 @@ impl Recorder {
             self.take(scene)?;
         }
         if let Some(dt) = self.interval {
-            // Skip samples a run already passed (never two rows at one time).
+            // Skip samples a run already passed (never two rows at one time), in O(1): the
+            // interval is resolvable at t (checked by `check_run`), so the loop is short.
+            let k = ((t - self.start) / dt).floor();
+            if k.is_finite() && k >= 0.0 {
+                self.next_k = self.next_k.max(k as u64);
+            }
             while self.start + self.next_k as f64 * dt <= t {
                 self.next_k += 1;
             }
+        }
+        Ok(())
+    }
+
+    /// Refuse, before a run from `t0` to `t_end`, a periodic trigger that the run cannot resolve
+    /// or that would add more than [`MAX_ROWS_PER_RUN`] rows.
+    pub fn check_run(&self, t0: f64, t_end: f64) -> Result<()> {
+        let Some(dt) = self.interval else {
+            return Ok(());
+        };
+        let scale = t0.abs().max(t_end.abs()).max(self.start.abs());
+        if dt < MIN_RELATIVE_INTERVAL * scale {
+            return Err(invalid!(
+                "the recorder of {} ({}, an interval of {dt:e} s) cannot be resolved at t = {scale:e} s: f64 tells times apart only down to ~{:e} s there; record less often (a larger every_periods(n) or every_seconds(t))",
+                self.columns()[1..].join(", "),
+                self.trigger.describe(),
+                MIN_RELATIVE_INTERVAL * scale
+            ));
+        }
+        let rows = (t_end - t0) / dt;
+        if rows > MAX_ROWS_PER_RUN {
+            let values = rows * self.columns().len() as f64;
+            return Err(invalid!(
+                "this run would add {rows:.3e} rows to the recorder of {} ({}), about {:.1} GB in memory; the limit is {MAX_ROWS_PER_RUN:e} rows per run: record less often, or split the run into shorter runs",
+                self.columns()[1..].join(", "),
+                self.trigger.describe(),
+                values * 8e-9
+            ));
         }
         Ok(())
     }
@@ -154,24 +211,68 @@ impl Recorder {
         for o in &self.observables {
             row.extend(o.evaluate(scene)?);
         }
+        let line = self.stream.as_ref().map(|_| csv_line(&row));
         self.rows.push(row);
+        match (&mut self.stream, line) {
+            (Some(s), Some(line)) => s.append(&line),
+            _ => Ok(()),
+        }
+    }
+
+    /// Stream rows to `path` as CSV from now on: the file is created with the header and every
+    /// row taken so far, then each new row is appended (one whole line, unbuffered) as it is
+    /// taken. A kill loses no row already recorded; a later `stream_csv` moves the stream.
+    pub fn stream_csv(&mut self, path: &std::path::Path) -> Result<()> {
+        let mut lines = vec![csv_line(&self.header())];
+        lines.extend(self.rows.iter().map(|r| csv_line(r)));
+        self.stream = Some(LineStream::create(path, &lines)?);
         Ok(())
     }
 
-    /// Write the rows as CSV with a header carrying names and units.
+    /// The file rows are streamed to, if any.
+    pub fn stream_path(&self) -> Option<&std::path::Path> {
+        self.stream.as_ref().map(LineStream::path)
+    }
+
+    /// Write the rows as CSV with a header carrying names and units (to a temporary file renamed
+    /// over `path`: a crash keeps the old file whole).
     pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| invalid!("cannot create folder {}: {e}", dir.display()))?;
+        write_atomically(path, |w| {
+            writeln!(w, "{}", csv_line(&self.header()))?;
+            for row in &self.rows {
+                writeln!(w, "{}", csv_line(row))?;
+            }
+            Ok(())
+        })
+    }
+}
+
+/// One CSV line (without the newline): numbers in shortest round-trip form, text quoted where
+/// the csv crate would.
+fn csv_line<T: CsvField>(fields: &[T]) -> String {
+    fields
+        .iter()
+        .map(CsvField::field)
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+trait CsvField {
+    fn field(&self) -> String;
+}
+
+impl CsvField for f64 {
+    fn field(&self) -> String {
+        format!("{self:?}")
+    }
+}
+
+impl CsvField for String {
+    fn field(&self) -> String {
+        if self.contains([',', '"', '\n', '\r']) {
+            format!("\"{}\"", self.replace('"', "\"\""))
+        } else {
+            self.clone()
         }
-        let err = |e: csv::Error| invalid!("cannot write {}: {e}", path.display());
-        let mut w = csv::Writer::from_path(path).map_err(err)?;
-        w.write_record(self.header()).map_err(err)?;
-        for row in &self.rows {
-            w.write_record(row.iter().map(|v| format!("{v:?}")))
-                .map_err(err)?;
-        }
-        w.flush()
-            .map_err(|e| invalid!("cannot write {}: {e}", path.display()))
     }
 }

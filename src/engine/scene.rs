@@ -32,6 +32,14 @@ pub const DEFAULT_RIGID_RTOL: f64 = 1e-7;
 /// Default tolerance of the averaged model's adaptive integrator.
 pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 
+/// The latest time a scene may hold, in stroke periods: at 1e9 periods f64 still resolves the
+/// phase to ~1e-7 of a period (and a default microscopic step to ~1e-4 of itself).
+pub const MAX_TIME_IN_PERIODS: f64 = 1e9;
+
+/// Most steps one run of a fixed-step integrator may take (~1e5 s, a day, at 1 µs a step): a
+/// longer run is refused with the numbers before it starts; split it into several runs.
+pub const MAX_FIXED_STEPS_PER_RUN: f64 = 1e11;
+
 /// Version of the JSON layout written by [`Scene::to_json`].
 pub const SAVE_FORMAT: u32 = 1;
 
@@ -492,10 +500,111 @@ impl Scene {
                 s.state.len()
             ));
         }
-        for d in &s.swimmers {
-            d.validate()?;
-        }
+        s.validate()?;
         Ok(s)
+    }
+
+    /// The smallest gap |x_α − x_β| − a_α − a_β over all pairs of spheres (m) and the two spheres
+    /// (sphere α belongs to swimmer α/2, the a1 sphere first); `None` with fewer than two spheres.
+    pub fn closest_spheres(&self) -> Option<(f64, usize, usize)> {
+        let n = 2 * self.count();
+        let mut soa = super::pairs::SoaSpheres::default();
+        soa.resize(n);
+        let mut radii = Vec::with_capacity(n);
+        for i in 0..self.count() {
+            let (a, b) = self.spheres(i);
+            let d = &self.swimmers[i];
+            for (k, (p, r)) in [(a, d.a1), (b, d.a2)].into_iter().enumerate() {
+                let j = 2 * i + k;
+                (soa.x[j], soa.y[j], soa.z[j]) = (p.x, p.y, p.z);
+                radii.push(r);
+            }
+        }
+        super::pairs::min_gap(&soa, &radii, n >= 256)
+    }
+
+    /// Check a scene read from a file as the setters check their values: a file that was edited
+    /// by hand, truncated or written by something else is refused with the value at fault.
+    fn validate(&self) -> Result<()> {
+        require_positive("mu", self.mu, "Pa s")?;
+        match self.integrator {
+            Some(IntegratorSpec::Euler { dt }) => IntegratorSpec::euler(dt).map(|_| ())?,
+            Some(IntegratorSpec::Rk4 { dt }) => IntegratorSpec::rk4(dt).map(|_| ())?,
+            Some(IntegratorSpec::Dopri5 { rtol }) => IntegratorSpec::dopri5(rtol).map(|_| ())?,
+            Some(IntegratorSpec::Rosw { rtol }) => IntegratorSpec::rosw(rtol).map(|_| ())?,
+            None => {}
+        }
+        if let Some(st) = self.contacts.steric {
+            Steric::new(st.range, st.stiffness)?;
+        }
+        if let Some(c) = self.cutoff {
+            let mut probe = Scene::new();
+            probe.set_cutoff(Some(c))?;
+        }
+        for (i, d) in self.swimmers.iter().enumerate() {
+            d.validate().map_err(|e| invalid!("swimmer {i}: {e}"))?;
+        }
+        require_finite("time", self.time)?;
+        if self.time < 0.0 {
+            return Err(invalid!(
+                "time is {:e} s; a scene's time starts at 0 and only grows",
+                self.time
+            ));
+        }
+        let t_max = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(1.0, f64::max)
+            * MAX_TIME_IN_PERIODS;
+        if self.time > t_max {
+            return Err(invalid!(
+                "time is {:e} s, beyond {MAX_TIME_IN_PERIODS:e} stroke periods ({t_max:e} s), where f64 no longer resolves the stroke; reset the time to 0 (the state is what matters)",
+                self.time
+            ));
+        }
+        for (i, b) in self.base.iter().enumerate() {
+            if !b.iter().all(|x| x.is_finite()) {
+                return Err(invalid!("base position of swimmer {i} is not finite"));
+            }
+        }
+        if let Some(k) = self.state.iter().position(|v| !v.is_finite()) {
+            return Err(invalid!(
+                "state value {k} (swimmer {}) is not finite",
+                k / STATE_PER_SWIMMER
+            ));
+        }
+        for i in 0..self.count() {
+            let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
+            let len = v.norm();
+            match self.model {
+                Model::Micro if len <= 0.0 => {
+                    return Err(invalid!(
+                        "swimmer {i}: its dumbbell vector X2 - X1 is zero; a dumbbell needs two distinct spheres"
+                    ))
+                }
+                Model::Averaged | Model::Rigid if (len - 1.0).abs() > 1e-9 => {
+                    return Err(invalid!(
+                        "swimmer {i}: its orientation N has length {len}, not 1; in the {} model the state holds the unit vector N",
+                        self.model.name()
+                    ))
+                }
+                _ => {}
+            }
+        }
+        if let Some((gap, a, b)) = self.closest_spheres() {
+            let same = a / 2 == b / 2;
+            if gap <= 0.0 && (same || !self.contacts.allow_overlap) {
+                return Err(invalid!(
+                    "spheres {a} and {b} (swimmers {} and {}) overlap by {:.3e} m; move them apart{}",
+                    a / 2,
+                    b / 2,
+                    -gap,
+                    if same { "" } else { ", or allow overlaps (\"overlaps\": allow)" }
+                ));
+            }
+        }
+        Ok(())
     }
 
     // ----- reading ---------------------------------------------------------------------------
@@ -743,6 +852,7 @@ impl Scene {
             ));
         }
         let t_end = self.time + duration;
+        self.check_run(t_end)?;
         loop {
             // Stop where a recorder wants a row, so nothing is evaluated between rows.
             let segment_end = self
@@ -758,6 +868,34 @@ impl Scene {
                 return Ok(());
             }
         }
+    }
+
+    /// What is refused before a run to `t_end` starts: a recorder the run cannot resolve or that
+    /// would take more rows than [`super::recorder::MAX_ROWS_PER_RUN`], a fixed step that cannot
+    /// advance the time, more than [`MAX_FIXED_STEPS_PER_RUN`] steps.
+    fn check_run(&self, t_end: f64) -> Result<()> {
+        if t_end <= self.time {
+            return Ok(());
+        }
+        for r in &self.recorders {
+            r.check_run(self.time, t_end)?;
+        }
+        if let IntegratorSpec::Euler { dt } | IntegratorSpec::Rk4 { dt } = self.integrator() {
+            let scale = self.time.abs().max(t_end.abs());
+            if dt < super::recorder::MIN_RELATIVE_INTERVAL * scale {
+                return Err(invalid!(
+                    "the step dt = {dt:e} s cannot advance the time at t = {scale:e} s (f64 resolves only ~{:e} s there); use a larger step, or a new scene from time 0",
+                    super::recorder::MIN_RELATIVE_INTERVAL * scale
+                ));
+            }
+            let steps = (t_end - self.time) / dt;
+            if steps > MAX_FIXED_STEPS_PER_RUN {
+                return Err(invalid!(
+                    "this run would take {steps:.3e} steps of dt = {dt:e} s, more than the {MAX_FIXED_STEPS_PER_RUN:e} one run may take (days of computing); run a shorter time, split it into several runs, or use a larger step"
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn fire_recorders(&mut self, end_of_run: bool) -> Result<()> {
@@ -926,6 +1064,13 @@ impl Scene {
     pub fn add_recorder(&mut self, r: Recorder) -> usize {
         self.recorders.push(r);
         self.recorders.len() - 1
+    }
+
+    /// A recorder by id, to change (e.g. to stream its rows).
+    pub fn recorder_mut(&mut self, id: usize) -> Result<&mut Recorder> {
+        self.recorders
+            .get_mut(id)
+            .ok_or_else(|| invalid!("recorder {id} does not belong to this scene"))
     }
 
     /// A recorder by id.

@@ -206,6 +206,9 @@ impl Format {
     }
 }
 
+/// The most decades a log axis may span (its ticks and grid are drawn per decade).
+pub const MAX_LOG_DECADES: f64 = 100.0;
+
 impl Figure {
     /// Check that the figure can be drawn: at least one series, x and y of equal length, finite
     /// values, and positive values on log axes; sizes between 100 and 8000 pixels.
@@ -251,7 +254,32 @@ impl Figure {
                 }
             }
         }
+        for (x_axis, axis, log) in [(true, "x", self.log_x), (false, "y", self.log_y)] {
+            let (lo, hi) = self.range(x_axis);
+            if log && hi - lo > MAX_LOG_DECADES {
+                return Err(format!(
+                    "the {axis} values span {:.0} decades; a log axis can show at most {MAX_LOG_DECADES}: leave out the extreme values",
+                    hi - lo
+                ));
+            }
+            if !log && !(hi - lo).is_finite() {
+                let (a, b) = self.data_range(x_axis);
+                return Err(format!(
+                    "the {axis} values span from {a:e} to {b:e}, wider than f64 can draw; leave out the extreme values or divide them by a common scale"
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// Smallest and largest value on one axis.
+    fn data_range(&self, x_axis: bool) -> (f64, f64) {
+        self.series
+            .iter()
+            .flat_map(|s| if x_axis { &s.x } else { &s.y })
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(*v), b.max(*v))
+            })
     }
 
     /// Draw to `path` (SVG or PNG by its extension); folders are created.

@@ -19,8 +19,19 @@ fn register_font() {
     });
 }
 
-fn err(e: impl std::fmt::Debug) -> String {
-    format!("cannot draw the picture: {e:?}")
+/// A drawing error as a message: a backend (file) error names the cause and the fix; anything
+/// else is plotters' own text.
+fn err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
+    match e {
+        DrawingAreaErrorKind::BackendError(inner) => {
+            let text = inner.to_string();
+            let text = text.trim_start_matches("Drawing backend error: ");
+            format!(
+                "cannot write the picture: {text}; check that the folder exists and is writable"
+            )
+        }
+        other => format!("cannot draw the picture: {other}"),
+    }
 }
 
 /// Draw `f` to `path` in `format`.

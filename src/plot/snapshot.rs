@@ -67,6 +67,10 @@ impl Default for SnapshotOptions {
     }
 }
 
+/// The widest scene a snapshot draws, in radii of its largest sphere (a sphere of 1 µm in a
+/// scene a kilometre across).
+pub const MAX_EXTENT_IN_RADII: f64 = 1e9;
+
 /// Draw `scene` to `path` (SVG or PNG by extension); folders are created.
 pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<(), String> {
     let format = Format::of(path)?;
@@ -113,6 +117,16 @@ pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<()
             fill: RGBColor(r2, g2, b2),
         });
         rods.push((k, k + 1));
+    }
+    let (lo, hi, r_max) = discs.iter().fold(
+        (f64::INFINITY, f64::NEG_INFINITY, 0.0f64),
+        |(lo, hi, r), d| (lo.min(d.x.min(d.y)), hi.max(d.x.max(d.y)), r.max(d.r)),
+    );
+    if !((hi - lo).is_finite() && hi - lo <= MAX_EXTENT_IN_RADII * r_max) {
+        return Err(format!(
+            "the swimmers span {:.3e} m in this plane, over {MAX_EXTENT_IN_RADII:e} times their largest sphere: every sphere would be below a pixel; draw a scene of the region of interest (s.copy() and fewer swimmers)",
+            (hi - lo) / um
+        ));
     }
     let names = ["x [µm]", "y [µm]", "z [µm]"];
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {

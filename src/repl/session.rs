@@ -88,6 +88,13 @@ impl Session {
     }
 
     fn eval(&mut self, name: &str, source: &str) -> Reply {
+        let source = script::strip_bom(source);
+        // A panic (a bug) becomes an error reply; the session, its scope and scenes stay.
+        let guarded = script::guard(name, || Ok(self.eval_unguarded(name, source)));
+        guarded.unwrap_or_else(Reply::Error)
+    }
+
+    fn eval_unguarded(&mut self, name: &str, source: &str) -> Reply {
         interrupt::clear();
         let ast = match self.engine.compile_with_scope(&self.scope, source) {
             Ok(a) => a,
@@ -152,9 +159,13 @@ impl Session {
             "load" if arg.is_empty() => {
                 Reply::Error(":load needs a file: :load scripts/pair.rhai".into())
             }
-            "load" => match std::fs::read_to_string(arg) {
+            "load" => match script::read_text(
+                std::path::Path::new(arg),
+                script::MAX_SOURCE_BYTES,
+                "script",
+            ) {
                 Ok(src) => self.eval(arg, &src),
-                Err(e) => Reply::Error(format!("cannot read {arg}: {e}")),
+                Err(e) => Reply::Error(format!("error: {e}")),
             },
             other => Reply::Error(format!(
                 "unknown command :{other}; commands: {}",

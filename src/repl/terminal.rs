@@ -34,8 +34,21 @@ pub fn run() -> bool {
     if std::io::stdin().is_terminal() {
         interactive()
     } else {
-        piped(std::io::stdin().lock(), &mut std::io::stdout())
+        piped(
+            std::io::stdin().lock(),
+            &mut std::io::stdout(),
+            &mut std::io::stderr(),
+        )
     }
+}
+
+/// Append the entries added since the last call to the history file (created with its folder),
+/// so that a closed terminal or a killed process loses no command already entered.
+fn append_history(rl: &mut Editor<ReplHelper, DefaultHistory>, path: &std::path::Path) {
+    if let Some(dir) = path.parent() {
+        let _ = std::fs::create_dir_all(dir);
+    }
+    let _ = rl.append_history(path);
 }
 
 fn interactive() -> bool {
@@ -62,13 +75,18 @@ fn interactive() -> bool {
             Ok(line) => {
                 if !line.trim().is_empty() {
                     let _ = rl.add_history_entry(line.as_str());
+                    if let Some(h) = &history {
+                        append_history(&mut rl, h);
+                    }
                 }
                 let reply = session.borrow_mut().handle(&line);
                 match reply {
                     Reply::Quit => break,
                     Reply::Output(s) if s.is_empty() => {}
                     Reply::Output(s) => println!("{s}"),
-                    Reply::Error(s) => print!("{s}{}", if s.ends_with('\n') { "" } else { "\n" }),
+                    Reply::Error(s) => {
+                        eprint!("{s}{}", if s.ends_with('\n') { "" } else { "\n" })
+                    }
                 }
                 let _ = std::io::stdout().flush();
             }
@@ -80,18 +98,12 @@ fn interactive() -> bool {
             }
         }
     }
-    if let Some(h) = &history {
-        if let Some(dir) = h.parent() {
-            let _ = std::fs::create_dir_all(dir);
-        }
-        let _ = rl.save_history(h);
-    }
     true
 }
 
-/// Read inputs from `input` (multi-line statements joined until they parse), write replies to
-/// `out`. Returns false if any input failed.
-pub fn piped(input: impl BufRead, out: &mut dyn Write) -> bool {
+/// Read inputs from `input` (multi-line statements joined until they parse), write values to
+/// `out` and errors to `err`. Returns false if any input failed.
+pub fn piped(input: impl BufRead, out: &mut dyn Write, err: &mut dyn Write) -> bool {
     let mut session = Session::new();
     let mut buffer = String::new();
     let mut ok = true;
@@ -100,7 +112,7 @@ pub fn piped(input: impl BufRead, out: &mut dyn Write) -> bool {
         let line = match lines.next() {
             Some(Ok(l)) => l,
             Some(Err(e)) => {
-                let _ = writeln!(out, "error: cannot read input: {e}");
+                let _ = writeln!(err, "error: cannot read input: {e}");
                 return false;
             }
             None => break,
@@ -120,13 +132,14 @@ pub fn piped(input: impl BufRead, out: &mut dyn Write) -> bool {
             }
             Reply::Error(s) => {
                 ok = false;
-                let _ = write!(out, "{s}{}", if s.ends_with('\n') { "" } else { "\n" });
+                let _ = out.flush();
+                let _ = write!(err, "{s}{}", if s.ends_with('\n') { "" } else { "\n" });
             }
         }
     }
     if !buffer.trim().is_empty() {
         let _ = writeln!(
-            out,
+            err,
             "error: the input ended inside an unfinished statement:\n{buffer}"
         );
         ok = false;

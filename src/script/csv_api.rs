@@ -1,6 +1,7 @@
 //! `write_csv(path, rows)` / `write_csv(path, columns, rows)`: tables from scripts.
 
 use super::convert::{script_error, ScriptResult};
+use crate::engine::files::write_atomically;
 use rhai::{Array, Dynamic, Engine, Map};
 use std::path::Path;
 
@@ -13,30 +14,31 @@ fn cell(v: &Dynamic) -> String {
     }
 }
 
-/// Write `rows` (maps) under the header `columns` to `path`, creating parent folders.
+/// Write `rows` (maps) under the header `columns` to `path`, creating parent folders (through a
+/// temporary file renamed over `path`: a crash keeps the old file whole).
 pub fn write_table(path: &str, columns: &[String], rows: &[Map]) -> ScriptResult<()> {
-    let p = Path::new(path);
-    if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| script_error(format!("cannot create folder {}: {e}", dir.display())))?;
-    }
-    let mut w =
-        csv::Writer::from_path(p).map_err(|e| script_error(format!("cannot write {path}: {e}")))?;
-    let io = |e: csv::Error| script_error(format!("cannot write {path}: {e}"));
-    w.write_record(columns).map_err(io)?;
+    let mut records = Vec::with_capacity(rows.len());
     for (k, row) in rows.iter().enumerate() {
         let record: Vec<String> = columns
             .iter()
             .map(|c| {
                 row.get(c.as_str()).map(cell).ok_or_else(|| {
-                    script_error(format!("write_csv: row {k} has no column \"{c}\""))
+                    script_error(format!(
+                        "write_csv: row {k} has no column \"{c}\"; give every row the same keys"
+                    ))
                 })
             })
             .collect::<ScriptResult<_>>()?;
-        w.write_record(&record).map_err(io)?;
+        records.push(record);
     }
-    w.flush()
-        .map_err(|e| script_error(format!("cannot write {path}: {e}")))
+    super::convert::lift(write_atomically(Path::new(path), |w| {
+        let mut csv = csv::Writer::from_writer(w);
+        csv.write_record(columns)?;
+        for r in &records {
+            csv.write_record(r)?;
+        }
+        csv.flush()
+    }))
 }
 
 fn maps(rows: Array) -> ScriptResult<Vec<Map>> {

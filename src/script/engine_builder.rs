@@ -1,10 +1,14 @@
 //! The one place a Rhai engine is built and scripts are run.
 
 use super::{
-    csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, observable_api, plot_api,
-    render_error, scene_api, stdlib, sweep_api, util_api,
+    csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, limits, observable_api,
+    panic_guard::guard, params, plot_api, render_error, scene_api, stdlib, sweep_api, util_api,
 };
-use rhai::{Engine, Scope};
+use rhai::{Dynamic, Engine, EvalAltResult, Scope};
+
+/// The largest script or scene file swimlab reads (bytes): far above any real one, and a bound
+/// on what a wrong path (a device, a huge data file) can cost.
+pub const MAX_SOURCE_BYTES: u64 = 16 << 20;
 
 /// A Rhai engine with the whole swimlab vocabulary registered.
 pub fn engine() -> Engine {
@@ -16,6 +20,7 @@ pub fn engine() -> Engine {
 pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResolver) {
     let mut engine = Engine::new();
     engine.set_max_expr_depths(256, 256);
+    limits::apply(&mut engine);
     dumbbell_api::register(&mut engine);
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);
@@ -25,27 +30,119 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     util_api::register(&mut engine);
     sweep_api::register(&mut engine);
     plot_api::register(&mut engine);
+    params::register_defaults(&mut engine);
     let embedded = stdlib::install(&mut engine);
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
     (engine, embedded)
 }
 
+/// Script text without a leading UTF-8 byte-order mark (editors on Windows write one).
+pub fn strip_bom(source: &str) -> &str {
+    source.strip_prefix('\u{feff}').unwrap_or(source)
+}
+
 /// Run script text; on error return the rendered message (file, line, column, caret).
 pub fn run_source(name: &str, source: &str, scope: &mut Scope) -> Result<(), String> {
-    interrupt::clear();
-    let engine = engine();
-    let ast = engine
-        .compile_with_scope(scope, source)
-        .map_err(|e| render_error(name, source, &e.into()))?;
-    engine
-        .run_ast_with_scope(scope, &ast)
-        .map_err(|e| render_error(name, source, &e))
+    let source = strip_bom(source);
+    guard(name, || {
+        interrupt::clear();
+        let engine = engine();
+        let ast = engine
+            .compile_with_scope(scope, source)
+            .map_err(|e| render_error(name, source, &e.into()))?;
+        engine
+            .run_ast_with_scope(scope, &ast)
+            .map_err(|e| render_error(name, source, &e))
+    })
+}
+
+/// Run script text with `--set` constants: each is a constant of the script and the value of
+/// `param(name, default)`; a name the script never reads, or hides with its own `let`, is an
+/// error before anything runs.
+pub fn run_source_with(name: &str, source: &str, sets: &params::Sets) -> Result<(), String> {
+    let source = strip_bom(source);
+    guard(name, || {
+        interrupt::clear();
+        let mut engine = engine();
+        params::register(&mut engine, sets);
+        let mut scope = Scope::new();
+        for (n, v) in sets {
+            scope.push_constant_dynamic(n.clone(), v.clone());
+        }
+        let ast = engine
+            .compile_with_scope(&scope, source)
+            .map_err(|e| render_error(name, source, &e.into()))?;
+        params::check(&ast, sets).map_err(|(pos, msg)| {
+            render_error(
+                name,
+                source,
+                &EvalAltResult::ErrorRuntime(Dynamic::from(msg), pos),
+            )
+        })?;
+        engine
+            .run_ast_with_scope(&mut scope, &ast)
+            .map_err(|e| render_error(name, source, &e))
+    })
+}
+
+/// Read a text file of at most `max` bytes, with errors that name the file and the fix.
+pub fn read_text(path: &std::path::Path, max: u64, what: &str) -> Result<String, String> {
+    use std::io::Read;
+    let shown = path.display();
+    let file = std::fs::File::open(path).map_err(|e| {
+        format!("cannot read {what} {shown}: {e}; check the path (relative paths start in the working folder)")
+    })?;
+    if let Ok(m) = file.metadata() {
+        if m.is_dir() {
+            return Err(format!(
+                "cannot read {what} {shown}: it is a folder; give a file"
+            ));
+        }
+        if m.is_file() && m.len() > max {
+            return Err(format!(
+                "cannot read {what} {shown}: it is {} bytes, larger than the {max} of any {what} swimlab writes; check the path",
+                m.len()
+            ));
+        }
+    }
+    let mut bytes = Vec::new();
+    file.take(max + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
+    if bytes.len() as u64 > max {
+        return Err(format!(
+            "cannot read {what} {shown}: it is larger than {max} bytes, more than any {what} swimlab writes; check the path"
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        format!("cannot read {what} {shown}: it is not UTF-8 text ({e}); save it as UTF-8")
+    })
 }
 
 /// Run a script file.
 pub fn run_file(path: &std::path::Path, scope: &mut Scope) -> Result<(), String> {
-    let source = std::fs::read_to_string(path)
-        .map_err(|e| format!("error: cannot read {}: {e}\n", path.display()))?;
+    let source =
+        read_text(path, MAX_SOURCE_BYTES, "script").map_err(|e| format!("error: {e}\n"))?;
     run_source(&path.display().to_string(), &source, scope)
+}
+
+/// Run a script file with `--set` constants (see [`run_source_with`]).
+pub fn run_file_with(path: &std::path::Path, sets: &params::Sets) -> Result<(), String> {
+    let source =
+        read_text(path, MAX_SOURCE_BYTES, "script").map_err(|e| format!("error: {e}\n"))?;
+    run_source_with(&path.display().to_string(), &source, sets)
+}
+
+/// Evaluate one expression (`swimlab -e`) and return its value shown as the shell shows it.
+pub fn eval_expression(expr: &str) -> Result<Option<String>, String> {
+    guard("-e", || {
+        interrupt::clear();
+        let engine = engine();
+        let mut scope = Scope::new();
+        let v = engine
+            .eval_with_scope::<Dynamic>(&mut scope, expr)
+            .map_err(|e| render_error("-e", expr, &e))?;
+        Ok((!v.is_unit()).then(|| super::show(&v)))
+    })
 }

@@ -18,3 +18,16 @@ pub fn requested() -> bool {
 pub fn clear() {
     REQUESTED.store(false, Ordering::SeqCst);
 }
+
+/// Ctrl-C (SIGINT) for a batch run (`swimlab run`, `-e`, `make-figures`): the first one stops
+/// the run at its next step boundary, exactly as in the shell, so the script gets the interrupt
+/// error and streamed files end on a whole row; a second one ends the process at once (exit 130).
+pub fn install_batch_handler() {
+    let _ = ctrlc::set_handler(|| {
+        if requested() {
+            std::process::exit(130);
+        }
+        request();
+        eprintln!("\nswimlab: stopping at the next step boundary (Ctrl-C again quits at once)");
+    });
+}

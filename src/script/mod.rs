@@ -9,12 +9,16 @@ mod engine_builder;
 mod float_cmp;
 mod integrator_api;
 pub mod interrupt;
+pub mod limits;
 mod observable_api;
+mod panic_guard;
+pub mod params;
 mod plot_api;
 mod progress;
 mod render;
 mod scene_api;
 mod show;
+mod signatures;
 pub mod stdlib;
 mod sweep_api;
 mod util_api;
@@ -27,8 +31,12 @@ pub fn suggest_name(word: &str) -> Option<&'static str> {
     convert::suggest(word, &names)
 }
 pub use dumbbell_api::DumbbellSpec;
-pub use engine_builder::{engine, engine_and_stdlib, run_file, run_source};
+pub use engine_builder::{
+    engine, engine_and_stdlib, eval_expression, read_text, run_file, run_file_with, run_source,
+    run_source_with, strip_bom, MAX_SOURCE_BYTES,
+};
 pub use observable_api::RecorderHandle;
+pub use panic_guard::guard;
 pub use render::render_error;
 pub use scene_api::SceneHandle;
 pub use show::show;

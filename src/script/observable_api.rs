@@ -225,6 +225,8 @@ pub fn register(engine: &mut Engine) {
             r.with(|rec| rec.header().into_iter().map(Dynamic::from).collect())
         })
         .register_get("rows", |r: &mut RecorderHandle| -> ScriptResult<Array> {
+            let (n, cols) = r.with(|rec| (rec.rows.len(), rec.columns().len()))?;
+            super::limits::check_maps("rec.rows", n, cols)?;
             r.with(|rec| {
                 let cols = rec.columns();
                 rec.rows
@@ -249,12 +251,25 @@ pub fn register(engine: &mut Engine) {
                         "the recorder has no column \"{name}\"; see rec.columns"
                     ))
                 })?;
+                let n = r.with(|rec| rec.rows.len())?;
+                super::limits::check_array("rec.column(name)", n as f64)?;
                 r.with(|rec| {
                     rec.rows
                         .iter()
                         .map(|row| Dynamic::from_float(row[k]))
                         .collect()
                 })
+            },
+        )
+        .register_fn(
+            "stream_csv",
+            |r: &mut RecorderHandle, path: &str| -> ScriptResult<()> {
+                let mut scene = r.scene.borrow_mut();
+                lift(
+                    scene
+                        .recorder_mut(r.id)
+                        .and_then(|rec| rec.stream_csv(std::path::Path::new(path))),
+                )
             },
         )
         .register_fn(

@@ -1,49 +1,256 @@
-//! One error renderer for `swimlab run` and (later) the REPL: `file:line:col: message`, the source
-//! line, and a caret under the position.
+//! One error renderer for `swimlab run`, `-e` and the REPL: `file:line:col: message`, the source
+//! line, and a caret under the position (tabs and wide characters kept, so the caret lines up).
+//! Errors inside a stdlib module are reported at the user's call, with the module's line beneath.
+//! Rhai's own messages for unknown names and mismatched calls are rewritten into ones that name
+//! the fix: the closest known name, or the accepted forms of the call.
 
+use super::convert::suggest;
+use super::signatures::{shown_type, vocabulary};
 use rhai::{EvalAltResult, Position};
 
 /// Render a script error against its source text.
 pub fn render_error(name: &str, source: &str, err: &EvalAltResult) -> String {
-    let (pos, msg) = describe(err);
+    let d = describe(err);
     let mut out = String::new();
-    match (pos.line(), pos.position()) {
-        (Some(line), col) => {
-            let col = col.unwrap_or(1);
-            out.push_str(&format!("error: {name}:{line}:{col}: {msg}\n"));
-            if let Some(text) = source.lines().nth(line - 1) {
-                let gutter = format!("{line:>4} | ");
-                out.push_str(&format!("{gutter}{text}\n"));
-                out.push_str(&format!(
-                    "{}{}^\n",
-                    " ".repeat(gutter.len()),
-                    " ".repeat(col.saturating_sub(1))
-                ));
+    match d.pos.line() {
+        Some(line) => {
+            let col = d.pos.position().unwrap_or(1);
+            out.push_str(&format!("error: {name}:{line}:{col}: {}\n", d.msg));
+            out.push_str(&excerpt(source, line, col));
+        }
+        None => out.push_str(&format!("error: {name}: {}\n", d.msg)),
+    }
+    if let Some((module, pos)) = d.module {
+        if let Some(line) = pos.line() {
+            let col = pos.position().unwrap_or(1);
+            out.push_str(&format!("  inside module \"{module}\" at {line}:{col}:\n"));
+            if let Some(text) = module_source(&module) {
+                out.push_str(&excerpt(&text, line, col));
             }
         }
-        _ => out.push_str(&format!("error: {name}: {msg}\n")),
     }
     out
 }
 
+/// The source line and a caret under column `col` (1-based, counted in characters as Rhai does).
+fn excerpt(source: &str, line: usize, col: usize) -> String {
+    let Some(text) = source.lines().nth(line - 1) else {
+        return String::new();
+    };
+    let text = if line == 1 {
+        text.strip_prefix('\u{feff}').unwrap_or(text)
+    } else {
+        text
+    };
+    let gutter = format!("{line:>4} | ");
+    let pad: String = text
+        .chars()
+        .take(col.saturating_sub(1))
+        .map(|c| match c {
+            '\t' => "\t".to_string(),
+            c => " ".repeat(unicode_width::UnicodeWidthChar::width(c).unwrap_or(0)),
+        })
+        .collect();
+    format!("{gutter}{text}\n{}{pad}^\n", " ".repeat(gutter.len()))
+}
+
+/// The text of a module by the name Rhai gives as its source: embedded stdlib, else a file.
+fn module_source(module: &str) -> Option<String> {
+    super::stdlib::MODULES
+        .iter()
+        .find(|(n, _)| *n == module)
+        .map(|(_, s)| s.to_string())
+        .or_else(|| std::fs::read_to_string(module).ok())
+}
+
+/// Where an error is shown and what it says.
+struct Described {
+    /// Position in the user's source.
+    pos: Position,
+    msg: String,
+    /// The innermost position inside a module, if the error happened there.
+    module: Option<(String, Position)>,
+}
+
 /// The innermost position inside the script and a message without Rhai's "(line x, position y)".
-fn describe(err: &EvalAltResult) -> (Position, String) {
+fn describe(err: &EvalAltResult) -> Described {
     match err {
-        EvalAltResult::ErrorInFunctionCall(f, _, inner, pos) => {
-            let (ipos, imsg) = describe(inner);
-            if ipos.is_none() {
-                (*pos, format!("in call to {f}: {imsg}"))
+        EvalAltResult::ErrorInFunctionCall(f, src, inner, pos) => {
+            let d = describe(inner);
+            let f = f.as_str();
+            if !src.is_empty() && src != "<input>" {
+                // The inner position is in the module `src`; the user's position is the call.
+                let module = d.module.or_else(|| Some((src.clone(), d.pos)));
+                Described {
+                    pos: *pos,
+                    msg: format!("in {f}: {}", d.msg),
+                    module,
+                }
+            } else if d.pos.is_none() {
+                Described {
+                    pos: *pos,
+                    msg: format!("in call to {f}: {}", d.msg),
+                    module: d.module,
+                }
             } else {
-                (ipos, format!("in {f}: {imsg}"))
+                Described {
+                    pos: d.pos,
+                    msg: format!("in {f}: {}", d.msg),
+                    module: d.module,
+                }
             }
         }
-        EvalAltResult::ErrorRuntime(v, pos) => (*pos, v.to_string()),
+        EvalAltResult::ErrorInModule(m, inner, pos) => {
+            let d = describe(inner);
+            let module = d.module.or_else(|| Some((m.clone(), d.pos)));
+            Described {
+                pos: *pos,
+                msg: format!("in module \"{m}\": {}", d.msg),
+                module,
+            }
+        }
+        EvalAltResult::ErrorRuntime(v, pos) => plain(*pos, v.to_string()),
+        EvalAltResult::ErrorFunctionNotFound(sig, pos) => plain(*pos, function_not_found(sig)),
+        EvalAltResult::ErrorModuleNotFound(m, pos) => plain(*pos, module_not_found(m)),
+        EvalAltResult::ErrorDotExpr(msg, pos) => plain(*pos, property_not_found(msg)),
+        EvalAltResult::ErrorDataTooLarge(what, pos) => {
+            plain(*pos, super::limits::data_too_large(what))
+        }
+        EvalAltResult::ErrorStackOverflow(pos) => plain(*pos, super::limits::call_depth_exceeded()),
         other => {
             let pos = other.position();
             let msg = other.to_string();
             let suffix = format!(" ({pos})");
             let msg = msg.strip_suffix(&suffix).map(str::to_string).unwrap_or(msg);
-            (pos, msg)
+            plain(pos, msg)
         }
     }
+}
+
+fn plain(pos: Position, msg: String) -> Described {
+    Described {
+        pos,
+        msg,
+        module: None,
+    }
+}
+
+/// A note when the call passed a float where every form wants an integer (an index or count).
+fn integer_hint(call: &str, args: &[String], forms: &[String]) -> String {
+    let wants_int = |k: usize| {
+        forms.iter().all(|form| {
+            form.split_once('(')
+                .map(|(_, rest)| rest.trim_end_matches(')').split(", ").nth(k) == Some("int"))
+                .unwrap_or(false)
+        })
+    };
+    match args.iter().enumerate().find(|(k, a)| *a == "float" && wants_int(*k)) {
+        Some((k, _)) => format!(
+            "; argument {} of {call} must be an integer (an index or a count: write 10, not 10.0; to_int(x) converts)",
+            k + 1
+        ),
+        None => String::new(),
+    }
+}
+
+/// "run_period (Scene, i64)" → a message with the closest name, or the accepted forms.
+fn function_not_found(sig: &str) -> String {
+    let (name, args) = match sig.split_once(" (") {
+        Some((n, a)) => (n.trim(), a.trim_end_matches(')')),
+        None => (sig.trim(), ""),
+    };
+    let args: Vec<String> = if args.trim().is_empty() {
+        Vec::new()
+    } else {
+        args.split(", ").map(shown_type).collect()
+    };
+    let call = format!("{name}({})", args.join(", "));
+    let voc = vocabulary();
+    if let Some((alias, f)) = name.rsplit_once("::") {
+        // A module function: look for it (or the closest name) in every stdlib module, since
+        // the alias the script chose need not be the module's name.
+        if let Some((m, _)) = voc
+            .modules
+            .iter()
+            .find(|(_, fns)| fns.iter().any(|g| g == f))
+        {
+            return format!(
+                "{call}: {alias}::{f} exists but takes other arguments; see its definition in stdlib/{m}.rhai (:help {m})"
+            );
+        }
+        let best = voc
+            .modules
+            .iter()
+            .filter_map(|(m, fns)| {
+                let names: Vec<&str> = fns.iter().map(String::as_str).collect();
+                suggest(f, &names).map(|s| (m, s.to_string()))
+            })
+            .next();
+        return match best {
+            Some((m, s)) => format!(
+                "there is no function {alias}::{f}; did you mean {alias}::{s}? (module \"{m}\" has: {})",
+                voc.modules[m].join(", ")
+            ),
+            None => format!("there is no function {call}; check the module alias and the function name"),
+        };
+    }
+    if let Some(forms) = voc.functions.get(name) {
+        return format!(
+            "{name} cannot be called as {call}; its forms: {}{}",
+            forms.join(", "),
+            integer_hint(&call, &args, forms)
+        );
+    }
+    let names: Vec<&str> = voc.functions.keys().map(String::as_str).collect();
+    match suggest(name, &names) {
+        Some(s) => format!(
+            "there is no function {name}; did you mean {s}? Its forms: {}",
+            voc.functions[s].join(", ")
+        ),
+        None => format!("there is no function {call}; :help lists every name"),
+    }
+}
+
+fn module_not_found(m: &str) -> String {
+    let names: Vec<&str> = super::stdlib::MODULES.iter().map(|(n, _)| *n).collect();
+    let hint = suggest(m, &names)
+        .map(|s| format!("did you mean \"{s}\"? "))
+        .unwrap_or_default();
+    format!(
+        "there is no module \"{m}\"; {hint}the built-in modules are {}; a file module is named by its path without \".rhai\", relative to the working folder",
+        names.join(", ")
+    )
+}
+
+/// Rhai's "Unknown property 'foo' - a getter is not registered for type 'Scene'" (and the setter
+/// form) with the closest property of that type.
+fn property_not_found(msg: &str) -> String {
+    let quoted: Vec<&str> = msg.split('\'').skip(1).step_by(2).collect();
+    let (Some(prop), Some(ty)) = (quoted.first(), quoted.get(1)) else {
+        return msg.to_string();
+    };
+    let voc = vocabulary();
+    let setter = msg.starts_with("No writable property");
+    let table = if setter { &voc.setters } else { &voc.getters };
+    let Some(props) = table.get(*ty) else {
+        return msg.to_string();
+    };
+    let names: Vec<&str> = props.iter().map(String::as_str).collect();
+    let hint = suggest(prop, &names)
+        .map(|s| format!("did you mean .{s}? "))
+        .unwrap_or_default();
+    let what = if setter { "can be set" } else { "can be read" };
+    let mut text = format!(
+        "{ty} has no property .{prop}; {hint}the properties that {what}: {}",
+        names.join(", ")
+    );
+    if setter
+        && voc
+            .getters
+            .get(*ty)
+            .is_some_and(|g| g.iter().any(|p| p == prop))
+    {
+        text = format!("{ty}.{prop} can be read but not set");
+    }
+    text
 }

@@ -11,6 +11,9 @@ use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scen
 use rhai::{Array, Dynamic, Engine, ImmutableString, INT};
 use std::sync::{Arc, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
+/// The largest scene file `load_scene` reads (bytes): a saved scene of 10^5 swimmers is ~60 MB.
+pub const MAX_SCENE_FILE_BYTES: u64 = 256 << 20;
+
 /// A script's handle on a scene (Rhai type `Scene`).
 #[derive(Debug, Clone, Default)]
 pub struct SceneHandle(pub Arc<RwLock<Scene>>);
@@ -473,20 +476,22 @@ pub fn register(engine: &mut Engine) {
             "save",
             |s: &mut SceneHandle, path: &str| -> ScriptResult<()> {
                 let json = s.with(|sc| sc.to_json())?;
-                let p = std::path::Path::new(path);
-                if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
-                    std::fs::create_dir_all(dir).map_err(|e| {
-                        script_error(format!("cannot create folder {}: {e}", dir.display()))
-                    })?;
-                }
-                std::fs::write(p, json)
-                    .map_err(|e| script_error(format!("cannot write {path}: {e}")))
+                lift(crate::engine::files::write_atomically(
+                    std::path::Path::new(path),
+                    |w| w.write_all(json.as_bytes()),
+                ))
             },
         )
         .register_fn("load_scene", |path: &str| -> ScriptResult<SceneHandle> {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| script_error(format!("cannot read {path}: {e}")))?;
-            lift(Scene::from_json(&text)).map(SceneHandle::new)
+            let text = super::read_text(
+                std::path::Path::new(path),
+                MAX_SCENE_FILE_BYTES,
+                "scene file",
+            )
+            .map_err(script_error)?;
+            Scene::from_json(&text)
+                .map(SceneHandle::new)
+                .map_err(|e| script_error(format!("load_scene(\"{path}\"): {e}")))
         });
 
     // Running.

@@ -8,6 +8,10 @@ use super::convert::{script_error, ScriptResult};
 use rayon::prelude::*;
 use rhai::{Array, Dynamic, Engine, EvalAltResult, FnPtr, NativeCallContext, INT};
 
+/// Threads per core a sweep may ask for: more only adds switching (the calls compute, they do
+/// not wait).
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
 /// Run `f(p)` for every `p` in `params` on `threads` threads (`None`: rayon's pool, one per core).
 ///
 /// The call context is stored and re-created on each thread: Rhai's documented way to call a
@@ -70,6 +74,13 @@ pub fn register(engine: &mut Engine) {
                 if threads < 1 {
                     return Err(script_error(format!(
                         "sweep(params, f, threads): threads must be at least 1, got {threads}"
+                    )));
+                }
+                let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+                let most = MAX_THREADS_PER_CORE * cores;
+                if threads as usize > most {
+                    return Err(script_error(format!(
+                        "sweep(params, f, threads): {threads} threads on a machine with {cores} cores; at most {most} ({MAX_THREADS_PER_CORE} per core) are useful: give fewer, or leave threads out to use one per core"
                     )));
                 }
                 sweep(&ctx, params, f, Some(threads as usize))

@@ -1,5 +1,7 @@
 //! Small helpers scripts need: number formatting, `pi()`, and the quick mode of long scripts.
 
+use super::convert::{number, ScriptResult};
+use super::limits;
 use rhai::{Dynamic, Engine, INT};
 
 /// Whether scripts should run their quick variant (`swimlab run --quick`, or SWIMLAB_QUICK=1).
@@ -13,9 +15,10 @@ fn sci(x: f64, digits: INT) -> String {
 }
 
 /// `n` uniform numbers in [0, 1) from `seed` (splitmix64: reproducible on every platform).
-pub fn uniform_randoms(n: INT, seed: INT) -> rhai::Array {
+pub fn uniform_randoms(n: INT, seed: INT) -> ScriptResult<rhai::Array> {
+    let n = limits::check_array("uniform_randoms(n, seed)", n as f64)?;
     let mut state = seed as u64;
-    (0..n.max(0))
+    Ok((0..n)
         .map(|_| {
             state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
             let mut z = state;
@@ -24,7 +27,24 @@ pub fn uniform_randoms(n: INT, seed: INT) -> rhai::Array {
             z ^= z >> 31;
             Dynamic::from_float((z >> 11) as f64 / (1u64 << 53) as f64)
         })
-        .collect()
+        .collect())
+}
+
+/// `x` as text padded to `width` characters, on the left (`right == false`) or the right.
+fn pad(x: &Dynamic, width: INT, right: bool) -> ScriptResult<String> {
+    let what = if right {
+        "rpad(x, width)"
+    } else {
+        "lpad(x, width)"
+    };
+    let w = limits::check_string(what, width as f64)?;
+    let text = x.to_string();
+    let fill = " ".repeat(w.saturating_sub(text.chars().count()));
+    Ok(if right {
+        format!("{text}{fill}")
+    } else {
+        format!("{fill}{text}")
+    })
 }
 
 /// Register the helpers.
@@ -33,18 +53,18 @@ pub fn register(engine: &mut Engine) {
         .register_fn("pi", || std::f64::consts::PI)
         .register_fn("quick", quick)
         .register_fn("uniform_randoms", uniform_randoms)
-        .register_fn("sci", |x: f64| sci(x, 4))
-        .register_fn("sci", sci)
-        .register_fn("sci", |x: INT| sci(x as f64, 4))
-        .register_fn("fixed", |x: f64, digits: INT| {
+        .register_fn("sci", |x: Dynamic| -> ScriptResult<String> {
+            Ok(sci(number("sci(x)", &x)?, 4))
+        })
+        .register_fn("sci", |x: Dynamic, digits: INT| -> ScriptResult<String> {
+            Ok(sci(number("sci(x, digits)", &x)?, digits))
+        })
+        .register_fn("fixed", |x: Dynamic, digits: INT| -> ScriptResult<String> {
+            let x = number("fixed(x, digits)", &x)?;
             let d = digits.clamp(0, 17) as usize;
-            format!("{x:.d$}")
+            Ok(format!("{x:.d$}"))
         })
-        .register_fn("lpad", |x: Dynamic, width: INT| {
-            format!("{:>w$}", x.to_string(), w = width.max(0) as usize)
-        })
-        .register_fn("rpad", |x: Dynamic, width: INT| {
-            format!("{:<w$}", x.to_string(), w = width.max(0) as usize)
-        })
+        .register_fn("lpad", |x: Dynamic, width: INT| pad(&x, width, false))
+        .register_fn("rpad", |x: Dynamic, width: INT| pad(&x, width, true))
         .register_fn("is_number", |x: Dynamic| x.is_float() || x.is_int());
 }

@@ -46,21 +46,12 @@ impl IntegratorSpec {
 
     /// Dormand-Prince 5(4), checked: 1e-14 ≤ rtol < 1.
     pub fn dopri5(rtol: f64) -> Result<Self> {
-        require_positive("dopri5(rtol): rtol", rtol, "dimensionless")?;
-        if !(1e-14..1.0).contains(&rtol) {
-            return Err(crate::engine::error::invalid!(
-                "dopri5(rtol): rtol must lie in [1e-14, 1) (below 1e-14 the error estimate is round-off), got {rtol:e}"
-            ));
-        }
-        Ok(IntegratorSpec::Dopri5 { rtol })
+        check_rtol("dopri5", rtol).map(|rtol| IntegratorSpec::Dopri5 { rtol })
     }
 
     /// Rosenbrock-W ROS34PW2, checked: 1e-14 ≤ rtol < 1.
     pub fn rosw(rtol: f64) -> Result<Self> {
-        match Self::dopri5(rtol)? {
-            IntegratorSpec::Dopri5 { rtol } => Ok(IntegratorSpec::Rosw { rtol }),
-            other => Ok(other),
-        }
+        check_rtol("rosw", rtol).map(|rtol| IntegratorSpec::Rosw { rtol })
     }
 
     /// A fresh stepper for this spec.
@@ -72,6 +63,17 @@ impl IntegratorSpec {
             IntegratorSpec::Rosw { rtol } => Box::new(Rosenbrock::new(rtol)),
         }
     }
+}
+
+/// An adaptive method's tolerance: 1e-14 ≤ rtol < 1.
+fn check_rtol(method: &str, rtol: f64) -> Result<f64> {
+    require_positive(&format!("{method}(rtol): rtol"), rtol, "dimensionless")?;
+    if !(1e-14..1.0).contains(&rtol) {
+        return Err(crate::engine::error::invalid!(
+            "{method}(rtol): rtol must lie in [1e-14, 1) (below 1e-14 the error estimate is round-off), got {rtol:e}"
+        ));
+    }
+    Ok(rtol)
 }
 
 impl fmt::Display for IntegratorSpec {

@@ -109,7 +109,7 @@ pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<
             problem: Problem {
                 swimmer: None,
                 cause: format!("state component {i} became NaN or infinite"),
-                hint: "use a smaller time step (the spring is stiff: see s.stiff_dt) or the adaptive dopri5".into(),
+                hint: "use a smaller time step (the springs are stiff: RK4 needs dt below ~2.8 / s.stiff_rate) or the adaptive dopri5".into(),
             },
         });
     }

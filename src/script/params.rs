@@ -1,0 +1,128 @@
+//! `--set NAME=VALUE` constants of `swimlab run`, and `param(name, default)`, the way a script
+//! tells a value given on the command line from its own default.
+//!
+//! Before a script runs, its syntax tree is checked against the `--set` names: a name the script
+//! never reads is an error (a typo on a cluster job line would otherwise run the default
+//! silently), and so is a `let NAME = ...` or `const NAME = ...` that would shadow the value
+//! without reading it (write `let NAME = param("NAME", default);` instead).
+
+use rhai::{Dynamic, Engine, Position, AST};
+
+/// The `--set` values of one run, in command-line order.
+pub type Sets = [(String, Dynamic)];
+
+/// Register `param(name, default)`: the `--set` value of `name` if one was given, else `default`.
+pub fn register(engine: &mut Engine, sets: &Sets) {
+    let sets: Vec<(String, Dynamic)> = sets.to_vec();
+    engine.register_fn("param", move |name: &str, default: Dynamic| {
+        sets.iter()
+            .find(|(n, _)| n == name)
+            .map_or(default, |(_, v)| v.clone())
+    });
+}
+
+/// Register `param(name, default)` without any `--set` values (the shell, `-e`, tests).
+pub fn register_defaults(engine: &mut Engine) {
+    register(engine, &[]);
+}
+
+/// How a name appears in the script.
+#[derive(Default)]
+struct Uses {
+    /// Read as a variable or through `param("name", ...)`.
+    read: bool,
+    /// Top-level declarations that do not read the name: (position, keyword).
+    shadows: Vec<Position>,
+}
+
+/// Check the script against the `--set` names: every name read, none shadowed.
+pub fn check(ast: &AST, sets: &Sets) -> Result<(), (Position, String)> {
+    use rhai::{ASTNode, Expr, Stmt};
+    let names: Vec<&str> = sets.iter().map(|(n, _)| n.as_str()).collect();
+    let reads = |node: &ASTNode| -> Option<String> {
+        match node {
+            ASTNode::Expr(Expr::Variable(x, ..)) if x.2.is_empty() => Some(x.1.to_string()),
+            ASTNode::Expr(Expr::FnCall(f, ..)) if f.name == "param" && f.namespace.is_empty() => {
+                match f.args.first() {
+                    Some(Expr::StringConstant(s, ..)) => Some(s.to_string()),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    };
+    let mut uses: Vec<Uses> = names.iter().map(|_| Uses::default()).collect();
+    let mut all_reads: Vec<String> = Vec::new();
+    // Reads anywhere, closures and functions included.
+    ast.walk(&mut |path: &[ASTNode]| {
+        if let Some(name) = path.last().and_then(reads) {
+            if let Some(k) = names.iter().position(|n| *n == name) {
+                uses[k].read = true;
+            }
+            all_reads.push(name);
+        }
+        true
+    });
+    // Declarations in the script's own statements (a `let` inside a function is local to it).
+    let mut declared: Vec<(usize, Position, bool)> = Vec::new();
+    for stmt in ast.statements() {
+        let mut path = Vec::new();
+        stmt.walk(&mut path, &mut |path: &[ASTNode]| {
+            match path.last() {
+                Some(ASTNode::Stmt(Stmt::Var(x, _, pos))) => {
+                    if let Some(k) = names.iter().position(|n| *n == x.0.name.as_str()) {
+                        declared.push((k, *pos, false));
+                    }
+                }
+                Some(node) => {
+                    if let Some(name) = reads(node) {
+                        // A read inside the declaration of the same name takes the --set value.
+                        let inside_own = path[..path.len() - 1].iter().any(
+                            |a| matches!(a, ASTNode::Stmt(Stmt::Var(x, ..)) if x.0.name == name),
+                        );
+                        if inside_own {
+                            if let Some(d) =
+                                declared.iter_mut().rev().find(|(k, ..)| names[*k] == name)
+                            {
+                                d.2 = true;
+                            }
+                        }
+                    }
+                }
+                None => {}
+            }
+            true
+        });
+    }
+    for (k, pos, reads_itself) in declared {
+        if !reads_itself {
+            uses[k].shadows.push(pos);
+        }
+    }
+    for (k, u) in uses.iter().enumerate() {
+        let (name, value) = (&sets[k].0, &sets[k].1);
+        if let Some(pos) = u.shadows.first() {
+            return Err((
+                *pos,
+                format!(
+                    "this declaration of {name} hides the value given by --set {name}={value}; to let --set choose and keep a default, write let {name} = param(\"{name}\", <default>);"
+                ),
+            ));
+        }
+        if !u.read {
+            let mut known: Vec<&str> = all_reads.iter().map(String::as_str).collect();
+            known.sort_unstable();
+            known.dedup();
+            let hint = super::convert::suggest(name, &known)
+                .map(|s| format!(" (did you mean --set {s}=...?)"))
+                .unwrap_or_default();
+            return Err((
+                Position::NONE,
+                format!(
+                    "--set {name}={value}: the script never reads {name}{hint}; give only names the script uses, as a variable or through param(\"{name}\", default)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
