@@ -81,3 +81,24 @@ fn long_runs_show_a_progress_bar() {
     s.expect("=> 1").unwrap();
     s.expect(PROMPT).unwrap();
 }
+
+// History is appended as each command is entered: a terminal that dies (here: the shell is
+// killed with SIGKILL, which no exit handler sees) keeps every command typed before.
+#[test]
+fn history_survives_a_killed_terminal() {
+    let hist = std::env::temp_dir().join(format!("swimlab-pty-killed-{}", std::process::id()));
+    let _ = std::fs::remove_file(&hist);
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_swimlab"));
+    cmd.env("SWIMLAB_HISTORY", &hist).env("TERM", "xterm");
+    let mut s = Session::spawn(cmd).expect("spawn swimlab in a pty");
+    s.set_expect_timeout(Some(Duration::from_secs(20)));
+    s.expect(PROMPT).unwrap();
+    step(&mut s, "let kept = 41;", "");
+    step(&mut s, "kept + 1", "=> 42");
+    let pid = s.get_process().pid().to_string();
+    let killed = Command::new("kill").args(["-KILL", &pid]).status().unwrap();
+    assert!(killed.success());
+    let text = std::fs::read_to_string(&hist).expect("the history file exists");
+    assert!(text.contains("let kept = 41;"), "{text}");
+    assert!(text.contains("kept + 1"), "{text}");
+}

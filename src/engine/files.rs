@@ -33,12 +33,30 @@ pub fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
+    if path.as_os_str().is_empty() {
+        return Err(invalid!(
+            "cannot write a file with an empty name; give a path such as \"out/run.csv\""
+        ));
+    }
     ensure_parent(path)?;
     if path.is_dir() {
         return Err(invalid!(
             "cannot write {}: it is a folder; give a file name",
             path.display()
         ));
+    }
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        // A device or pipe (/dev/stdout, a FIFO) is written in place: renaming over it would
+        // replace the device node.
+        let result = std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .and_then(|f| {
+                let mut w = std::io::BufWriter::new(f);
+                fill(&mut w)?;
+                w.flush()
+            });
+        return result.map_err(|e| write_error(path, e));
     }
     let name = path
         .file_name()

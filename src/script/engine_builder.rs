@@ -70,8 +70,10 @@ pub fn run_source_with(name: &str, source: &str, sets: &params::Sets) -> Result<
         for (n, v) in sets {
             scope.push_constant_dynamic(n.clone(), v.clone());
         }
+        // Compiled without the constants, so that the optimiser does not fold them into the
+        // tree: the check must see every place the script reads them.
         let ast = engine
-            .compile_with_scope(&scope, source)
+            .compile(source)
             .map_err(|e| render_error(name, source, &e.into()))?;
         params::check(&ast, sets).map_err(|(pos, msg)| {
             render_error(

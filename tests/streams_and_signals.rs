@@ -1,0 +1,145 @@
+//! Recorded rows survive what ends a process: `rec.stream_csv` appends each row, whole, as it is
+//! taken, so `kill -9` loses no row already recorded and leaves no half line; SIGINT stops
+//! `swimlab run` at a step boundary as Ctrl-C does in the shell (the script gets the interrupt
+//! error, the stream is complete, the exit code is 130); the shell appends each command to its
+//! history as it is entered, so a killed terminal keeps it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("swimlab-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A long streamed recording of the Fig-1 pair (a row every 1/20 period; the run is far longer
+/// than the test waits).
+fn start_recording(d: &Path) -> (Child, PathBuf) {
+    let csv = d.join("rows.csv");
+    let script = d.join("long.rhai");
+    std::fs::write(
+        &script,
+        format!(
+            "import \"paper\" as paper;\nlet s = paper::mirror(10.0, true, true);\nlet r = s.record([R_H(0), length(1)], every_periods(0.05));\nr.stream_csv(\"{}\");\ns.run_periods(100000);\n",
+            csv.display()
+        ),
+    )
+    .unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", script.to_str().unwrap()])
+        .env("SWIMLAB_PROGRESS", "0")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start swimlab");
+    (child, csv)
+}
+
+fn lines_in(csv: &Path) -> usize {
+    std::fs::read_to_string(csv).map_or(0, |t| t.matches('\n').count())
+}
+
+/// Wait until the stream holds at least `n` lines (header included).
+fn wait_for_lines(csv: &Path, n: usize) -> usize {
+    let start = Instant::now();
+    loop {
+        let k = lines_in(csv);
+        if k >= n {
+            return k;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "the stream did not reach {n} lines (has {k})"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Every line whole: the header's number of fields, numbers that parse, a final newline.
+fn whole_rows(csv: &Path) -> usize {
+    let text = std::fs::read_to_string(csv).unwrap();
+    assert!(text.ends_with('\n'), "the file ends inside a line");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header[0], "time [s]");
+    let mut rows = 0;
+    let mut last_t = f64::NEG_INFINITY;
+    for l in lines {
+        let fields: Vec<f64> = l
+            .split(',')
+            .map(|f| {
+                f.parse()
+                    .unwrap_or_else(|e| panic!("bad field in {l:?}: {e}"))
+            })
+            .collect();
+        assert_eq!(fields.len(), header.len(), "a partial row: {l:?}");
+        assert!(fields[0] > last_t, "times increase");
+        last_t = fields[0];
+        rows += 1;
+    }
+    rows
+}
+
+fn signal(child: &Child, sig: &str) {
+    let ok = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok, "kill {sig} failed");
+}
+
+fn wait_within(child: &mut Child, limit: Duration) -> std::process::ExitStatus {
+    let start = Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("the process did not end within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[test]
+fn kill_9_during_a_streamed_recording_keeps_every_row_already_recorded() {
+    let d = dir("kill9");
+    let (mut child, csv) = start_recording(&d);
+    let seen = wait_for_lines(&csv, 60);
+    signal(&child, "-KILL");
+    wait_within(&mut child, Duration::from_secs(10));
+    let rows = whole_rows(&csv);
+    assert!(
+        rows + 1 >= seen,
+        "rows lost: {rows} rows, {seen} lines seen before the kill"
+    );
+}
+
+#[test]
+fn sigint_stops_swimlab_run_at_a_step_boundary_and_keeps_the_rows() {
+    let d = dir("sigint");
+    let (mut child, csv) = start_recording(&d);
+    let seen = wait_for_lines(&csv, 40);
+    signal(&child, "-INT");
+    // A step of the pair is ~1 µs: the run stops at once, the process soon after.
+    let status = wait_within(&mut child, Duration::from_secs(20));
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(status.code(), Some(130), "exit code; stderr:\n{err}");
+    assert!(err.contains("run interrupted at t ="), "{err}");
+    assert!(
+        err.contains("long.rhai:5:"),
+        "names the line of the run: {err}"
+    );
+    let rows = whole_rows(&csv);
+    assert!(
+        rows + 1 >= seen,
+        "{rows} rows, {seen} lines seen before SIGINT"
+    );
+}
