@@ -138,3 +138,36 @@ fn a_saved_scene_loads_back_exactly() {
     assert_eq!(t.raw_state().0, s.raw_state().0);
     assert!(Scene::from_json("{\"format\": 9, \"scene\": {}}").is_err());
 }
+
+/// A probe observable (one period on a copy) stops at a step boundary when interrupted, as a run
+/// does, and reports the scene's own time: the scene did not move.
+#[test]
+fn an_interrupt_stops_a_probe_mid_period() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let mut s = mirror_inwards(10.0, true);
+    s.run_periods(0.25, &never).unwrap();
+    let t0 = s.time();
+    // 1e9 steps per period: far longer than the test waits, so only the interrupt ends it.
+    s.set_integrator(Some(
+        swimlab::engine::IntegratorSpec::rk4(s.period().unwrap() * 1e-9).unwrap(),
+    ));
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let r = Observable::DeltaQ(0, 1).measure(&s, &|| flag.load(Ordering::Relaxed));
+        let _ = tx.send((r, s.time()));
+    });
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    stop.store(true, Ordering::Relaxed);
+    let (r, t) = rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("the probe stops once interrupted");
+    assert_eq!(
+        r,
+        Err(swimlab::engine::EngineError::Interrupted { time: t0 }),
+        "interrupted at the scene's own time"
+    );
+    assert_eq!(t, t0, "the scene is unchanged");
+}

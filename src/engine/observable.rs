@@ -153,6 +153,13 @@ impl Observable {
 
     /// The value now (1 or 3 components).
     pub fn evaluate(&self, s: &Scene) -> Result<Vec<f64>> {
+        self.measure(s, &super::scene::never)
+    }
+
+    /// The value now; the probes that run a period on a copy (`delta_q`, `delta_D_H`,
+    /// `mean_speed` in the sphere models) stop at a step boundary when `interrupted()` says so,
+    /// reporting the scene's own time (the scene itself is never changed).
+    pub fn measure(&self, s: &Scene, interrupted: &dyn Fn() -> bool) -> Result<Vec<f64>> {
         self.check(s)?;
         let v3 = |v: Vector3<f64>| vec![v.x, v.y, v.z];
         Ok(match *self {
@@ -178,12 +185,12 @@ impl Observable {
             Observable::DistanceH(i, j) => vec![(s.center(i)? - s.center(j)?).norm()],
             Observable::DeltaQ(i, j) => {
                 let q = Observable::Q(i, j);
-                let (before, after) = Self::over_a_period(s, &q)?;
+                let (before, after) = Self::over_a_period(s, &q, interrupted)?;
                 vec![before[0] - after[0]]
             }
             Observable::DeltaDistanceH(i, j) => {
                 let d = Observable::DistanceH(i, j);
-                let (before, after) = Self::over_a_period(s, &d)?;
+                let (before, after) = Self::over_a_period(s, &d, interrupted)?;
                 vec![(before[0] - after[0]) / s.swimmer(i)?.ell]
             }
             Observable::Polarization => {
@@ -207,7 +214,7 @@ impl Observable {
             }
             Observable::MinGap => vec![Self::min_gap(s)],
             Observable::MeanSpeed => {
-                let v = s.center_velocities()?;
+                let v = s.center_velocities_within(interrupted)?;
                 vec![v.iter().map(|v| v.norm()).sum::<f64>() / v.len().max(1) as f64]
             }
             Observable::PairDistances { bins, r_max } => Self::histogram(s, bins, r_max)?,
@@ -252,10 +259,16 @@ impl Observable {
     }
 
     /// Value of `obs` now and one period later, on a copy of the scene (the scene is not changed).
-    fn over_a_period(s: &Scene, obs: &Observable) -> Result<(Vec<f64>, Vec<f64>)> {
+    fn over_a_period(
+        s: &Scene,
+        obs: &Observable,
+        interrupted: &dyn Fn() -> bool,
+    ) -> Result<(Vec<f64>, Vec<f64>)> {
         let before = obs.evaluate(s)?;
         let mut probe = s.clone();
-        probe.run_periods(1.0, &super::scene::never)?;
+        probe
+            .run_periods(1.0, interrupted)
+            .map_err(|e| super::scene::probe_error(e, s))?;
         Ok((before, obs.evaluate(&probe)?))
     }
 }

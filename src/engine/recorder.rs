@@ -81,6 +81,16 @@ pub struct Recorder {
 impl Recorder {
     /// A recorder created on `scene` now; periodic triggers take their first row immediately.
     pub fn new(scene: &Scene, observables: Vec<Observable>, trigger: Trigger) -> Result<Self> {
+        Self::start(scene, observables, trigger, &super::scene::never)
+    }
+
+    /// [`Recorder::new`], its first row's probes (if any) stopped when `interrupted()` says so.
+    pub fn start(
+        scene: &Scene,
+        observables: Vec<Observable>,
+        trigger: Trigger,
+        interrupted: &dyn Fn() -> bool,
+    ) -> Result<Self> {
         trigger.validate()?;
         for o in &observables {
             o.check(scene)?;
@@ -110,11 +120,11 @@ impl Recorder {
             stream: None,
         };
         if r.interval.is_some() {
-            r.take(scene)?;
+            r.take(scene, interrupted)?;
             r.next_k = 1;
         } else if let Trigger::AtTimes(ts) = &r.trigger {
             if ts.contains(&scene.time()) {
-                r.take(scene)?;
+                r.take(scene, interrupted)?;
             }
         }
         Ok(r)
@@ -153,7 +163,12 @@ impl Recorder {
     }
 
     /// Take rows due at the scene's current time (after a run segment ended there).
-    pub fn fire(&mut self, scene: &Scene, end_of_run: bool) -> Result<()> {
+    pub fn fire(
+        &mut self,
+        scene: &Scene,
+        end_of_run: bool,
+        interrupted: &dyn Fn() -> bool,
+    ) -> Result<()> {
         let t = scene.time();
         let due = match (&self.trigger, self.interval) {
             (_, Some(dt)) => t >= self.start + self.next_k as f64 * dt,
@@ -162,7 +177,7 @@ impl Recorder {
             _ => false,
         };
         if due {
-            self.take(scene)?;
+            self.take(scene, interrupted)?;
         }
         if let Some(dt) = self.interval {
             // Skip samples a run already passed (never two rows at one time), in O(1): the
@@ -206,10 +221,10 @@ impl Recorder {
         Ok(())
     }
 
-    fn take(&mut self, scene: &Scene) -> Result<()> {
+    fn take(&mut self, scene: &Scene, interrupted: &dyn Fn() -> bool) -> Result<()> {
         let mut row = vec![scene.time()];
         for o in &self.observables {
-            row.extend(o.evaluate(scene)?);
+            row.extend(o.measure(scene, interrupted)?);
         }
         let line = self.stream.as_ref().map(|_| csv_line(&row));
         self.rows.push(row);

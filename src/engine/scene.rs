@@ -759,6 +759,14 @@ impl Scene {
     /// whose centres oscillate within a stroke, R_H's displacement over the next period divided
     /// by T (measured on a copy; the scene is not changed).
     pub fn center_velocities(&self) -> Result<Vec<Vector3<f64>>> {
+        self.center_velocities_within(&never)
+    }
+
+    /// [`Scene::center_velocities`], its probe period stopped when `interrupted()` says so.
+    pub fn center_velocities_within(
+        &self,
+        interrupted: &dyn Fn() -> bool,
+    ) -> Result<Vec<Vector3<f64>>> {
         let n = self.count();
         if self.model == Model::Averaged {
             let mut sys = self.system()?;
@@ -768,7 +776,9 @@ impl Scene {
         }
         let period = self.period()?;
         let mut probe = self.clone();
-        probe.run_periods(1.0, &never)?;
+        probe
+            .run_periods(1.0, interrupted)
+            .map_err(|e| probe_error(e, self))?;
         (0..n)
             .map(|i| Ok((probe.displacement(i)? - self.displacement(i)?) / period))
             .collect()
@@ -863,7 +873,7 @@ impl Scene {
                 .max(self.time);
             self.advance_to(segment_end, interrupted)?;
             let end_of_run = self.time >= t_end;
-            self.fire_recorders(end_of_run)?;
+            self.fire_recorders(end_of_run, interrupted)?;
             if end_of_run {
                 return Ok(());
             }
@@ -898,11 +908,11 @@ impl Scene {
         Ok(())
     }
 
-    fn fire_recorders(&mut self, end_of_run: bool) -> Result<()> {
+    fn fire_recorders(&mut self, end_of_run: bool, interrupted: &dyn Fn() -> bool) -> Result<()> {
         let mut recorders = std::mem::take(&mut self.recorders);
         let result = recorders
             .iter_mut()
-            .try_for_each(|r| r.fire(self, end_of_run));
+            .try_for_each(|r| r.fire(self, end_of_run, interrupted));
         self.recorders = recorders;
         result
     }
@@ -1114,6 +1124,15 @@ pub fn lattice_scene(swimmers: usize, model: Model) -> Result<Scene> {
         s.add(Dumbbell { phase, ..d }, c, Vector3::x())?;
     }
     Ok(s)
+}
+
+/// An interrupt of a probe run on a copy of `s`, reported at `s`'s own time (the copy's time means
+/// nothing to the user: `s` itself did not move).
+pub(crate) fn probe_error(e: EngineError, s: &Scene) -> EngineError {
+    match e {
+        EngineError::Interrupted { .. } => EngineError::Interrupted { time: s.time },
+        other => other,
+    }
 }
 
 /// A run that is never interrupted.

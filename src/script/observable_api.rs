@@ -160,7 +160,7 @@ pub fn register(engine: &mut Engine) {
         .register_fn(
             "observe",
             |s: &mut SceneHandle, o: Observable| -> ScriptResult<Dynamic> {
-                lift(o.evaluate(&s.borrow())).map(value)
+                lift(o.measure(&s.borrow(), &super::interrupt::requested)).map(value)
             },
         );
 
@@ -194,7 +194,12 @@ pub fn register(engine: &mut Engine) {
             |s: &mut SceneHandle, list: Array, every: Dynamic| -> ScriptResult<RecorderHandle> {
                 let obs = observables_of(&list)?;
                 let trigger = trigger_of(&every)?;
-                let rec = lift(Recorder::new(&s.borrow(), obs, trigger))?;
+                let rec = lift(Recorder::start(
+                    &s.borrow(),
+                    obs,
+                    trigger,
+                    &super::interrupt::requested,
+                ))?;
                 let id = s.borrow_mut().add_recorder(rec);
                 Ok(RecorderHandle {
                     scene: s.clone(),
