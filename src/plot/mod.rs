@@ -287,8 +287,12 @@ impl Figure {
         self.validate()?;
         let format = Format::of(path)?;
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+            std::fs::create_dir_all(dir).map_err(|e| {
+                format!(
+                    "cannot create folder {}: {e}; choose a path in a folder you can write to",
+                    dir.display()
+                )
+            })?;
         }
         render::figure(self, path, format)
     }
