@@ -9,8 +9,9 @@ mod common;
 use common::{aligned_pair, mirror_inwards, ELL};
 use nalgebra::Vector3;
 use swimlab::engine::build::{random_suspension, Orientations, Phases};
+use swimlab::engine::error::Setting;
 use swimlab::engine::scene::never;
-use swimlab::engine::{Backend, Dumbbell, IntegratorSpec, Model, Scene};
+use swimlab::engine::{Backend, Dumbbell, EngineError, IntegratorSpec, Model, Scene};
 
 fn gpu_present(test: &str) -> bool {
     match swimlab::engine::gpu::device() {
@@ -258,11 +259,16 @@ fn auto_explains_its_choice() {
     s.set_model(Model::Rigid);
     assert!(s.backend_info().unwrap().contains("rigid"));
     s.set_backend(Backend::Gpu);
-    let e = s.backend_info().unwrap_err().to_string();
+    let err = s.backend_info().unwrap_err();
+    let e = err.to_string();
+    // Engine terms for an embedder; the script layer shows the fix as `s.backend = "cpu"`.
+    assert!(e.contains("rigid") && e.contains("the cpu backend"), "{e}");
     assert!(
-        e.contains("rigid") && e.contains("s.backend = \"cpu\""),
-        "{e}"
+        matches!(&err, EngineError::Unsupported { fixes, .. } if fixes.contains(&Setting::Backend("cpu"))),
+        "{err:?}"
     );
+    let shown = swimlab::script::engine_message(&err);
+    assert!(shown.contains("s.backend = \"cpu\""), "{shown}");
 }
 
 // Without an adapter (hidden by SWIMLAB_NO_GPU): "auto" runs on the CPU and says so; "gpu" is a

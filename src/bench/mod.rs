@@ -4,6 +4,7 @@
 pub mod backends;
 pub mod pairs;
 pub mod plots;
+pub mod report;
 pub mod scaling;
 pub mod stability;
 pub mod table;

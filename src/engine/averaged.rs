@@ -495,6 +495,7 @@ impl OdeSystem for AveragedSystem {
                 swimmer: Some(s),
                 cause: format!("swimmers {s} and {r} have the same centre"),
                 hint: "start the swimmers apart: the averaged model is a far-field model".into(),
+                fixes: Vec::new(),
             });
         }
         if self.contacts.allow_overlap {

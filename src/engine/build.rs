@@ -89,7 +89,7 @@ pub fn random_suspension(
     require_positive("box side", side, "m")?;
     if n > MAX_RANDOM_SWIMMERS {
         return Err(invalid!(
-            "cannot place {n} swimmers at random in one call: placement checks every new swimmer against all placed ones (n^2/2 checks), so one call places at most {MAX_RANDOM_SWIMMERS}; place a lattice with s.add_at(d, lattice::cubic(...)) for more"
+            "cannot place {n} swimmers at random in one call: placement checks every new swimmer against all placed ones (n^2/2 checks), so one call places at most {MAX_RANDOM_SWIMMERS}; place more on a lattice"
         ));
     }
     // Over a stroke a sphere moves by w·2λ along its axis (w = a_other/(a1+a2)): two spheres

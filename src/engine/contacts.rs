@@ -40,7 +40,7 @@ impl Steric {
         for (name, v, unit) in [("range", range, "m"), ("stiffness", stiffness, "N/m")] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid!(
-                    "steric {name} must be a positive number of {unit}, got {v}; e.g. s.steric = #{{ range: 0.1e-6, stiffness: 1e-3 }}"
+                    "steric {name} must be a positive number of {unit}, got {v}; e.g. range 1e-7 m and stiffness 1e-3 N/m"
                 ));
             }
         }

@@ -2,15 +2,84 @@
 
 use thiserror::Error;
 
+/// A scene setting that an error names as its fix, in engine terms. The engine's messages show
+/// it in words ("the cpu backend"); the script layer shows it as the script line that makes it
+/// (`s.backend = "cpu"`), so neither layer's syntax leaks into the other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Setting {
+    /// Run on this backend ("cpu", "gpu", "auto").
+    Backend(&'static str),
+    /// Use this model ("micro", "rigid", "averaged").
+    Model(&'static str),
+    /// A fixed-step integrator (euler or rk4 with a step dt).
+    FixedStep,
+    /// The model's default integrator.
+    DefaultIntegrator,
+    /// A fixed step below ~2.8 over the scene's stiff rate.
+    StableStep,
+    /// Steric repulsion switched off.
+    NoSteric,
+    /// Steric repulsion between swimmers switched on.
+    Steric,
+    /// Overlapping spheres of different swimmers allowed.
+    AllowOverlaps,
+    /// No far-field cutoff.
+    NoCutoff,
+    /// A swimmer added to the scene.
+    AddSwimmer,
+    /// Swimmers placed on a lattice instead of at random.
+    Lattice,
+}
+
+impl std::fmt::Display for Setting {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Setting::Backend(b) => write!(f, "the {b} backend"),
+            Setting::Model(m) => write!(f, "the {m} model"),
+            Setting::FixedStep => {
+                f.write_str("a fixed-step integrator (euler or rk4 with a step dt)")
+            }
+            Setting::DefaultIntegrator => f.write_str("the model's default integrator"),
+            Setting::StableStep => f.write_str("a step below ~2.8 / (the scene's stiff rate)"),
+            Setting::NoSteric => f.write_str("no steric repulsion"),
+            Setting::Steric => f.write_str(
+                "steric repulsion between swimmers (e.g. range 1e-7 m, stiffness 1e-3 N/m)",
+            ),
+            Setting::AllowOverlaps => f.write_str("overlapping spheres allowed"),
+            Setting::NoCutoff => f.write_str("no cutoff (every pair)"),
+            Setting::AddSwimmer => f.write_str("adding a swimmer"),
+            Setting::Lattice => f.write_str("swimmers placed on a lattice"),
+        }
+    }
+}
+
+/// "use A or B" in engine words.
+fn fixes_in_words(fixes: &[Setting]) -> String {
+    fixes
+        .iter()
+        .map(Setting::to_string)
+        .collect::<Vec<_>>()
+        .join(" or ")
+}
+
 /// Everything that can go wrong in the engine.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum EngineError {
     /// A parameter or argument is out of its domain.
     #[error("{0}")]
     Invalid(String),
+    /// Something this scene's settings do not allow; any of `fixes` would.
+    #[error("{problem}; use {}", fixes_in_words(fixes))]
+    Unsupported {
+        /// What cannot be done, and why.
+        problem: String,
+        /// Settings that would allow it.
+        fixes: Vec<Setting>,
+    },
     /// A step produced a bad state (NaN/inf or overlapping spheres); the scene kept the last good one.
     #[error(
-        "the run stopped at t = {time:.6e} s: {cause}; the scene keeps the last good state (t = {last_good:.6e} s). Likely fix: {hint}"
+        "the run stopped at t = {time:.6e} s: {cause}; the scene keeps the last good state (t = {last_good:.6e} s). Likely fix: {hint}{}",
+        if fixes.is_empty() { String::new() } else { format!("; or use {}", fixes_in_words(fixes)) }
     )]
     StepFailed {
         /// Time at which the bad state was produced.
@@ -23,6 +92,8 @@ pub enum EngineError {
         cause: String,
         /// What to change.
         hint: String,
+        /// Settings that would avoid it.
+        fixes: Vec<Setting>,
     },
     /// The run was interrupted from outside (Ctrl-C) at a clean step boundary.
     #[error("run interrupted at t = {time:.6e} s; the scene keeps the state at that time")]
@@ -30,6 +101,14 @@ pub enum EngineError {
         /// Time at which the run stopped.
         time: f64,
     },
+}
+
+/// An [`EngineError::Unsupported`].
+pub fn unsupported(problem: impl Into<String>, fixes: &[Setting]) -> EngineError {
+    EngineError::Unsupported {
+        problem: problem.into(),
+        fixes: fixes.to_vec(),
+    }
 }
 
 /// Shorthand for engine results.

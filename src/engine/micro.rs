@@ -141,9 +141,10 @@ impl OdeSystem for MicroSystem {
                         dev.abs() / d.ell
                     ),
                     hint: format!(
-                        "use a smaller time step: explicit methods need dt below ~2.8/rate = {:.3e} s here (s.stiff_rate), or the default integrator",
+                        "use a smaller time step: explicit methods need dt below ~2.8/rate = {:.3e} s here (rate: the scene's stiff rate)",
                         2.785 / d.relaxation_rate(self.spheres.mu)
                     ),
+                    fixes: vec![crate::engine::error::Setting::DefaultIntegrator],
                 });
             }
         }

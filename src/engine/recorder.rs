@@ -182,7 +182,9 @@ impl Recorder {
         if let Some(dt) = self.interval {
             // Skip samples a run already passed (never two rows at one time), in O(1): the
             // interval is resolvable at t (checked by `check_run`), so the loop is short.
-            let k = ((t - self.start) / dt).floor();
+            // One below the estimate, so the loop finds the same first sample as counting up
+            // from next_k would, whatever the rounding of the division.
+            let k = ((t - self.start) / dt).floor() - 1.0;
             if k.is_finite() && k >= 0.0 {
                 self.next_k = self.next_k.max(k as u64);
             }

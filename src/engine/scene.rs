@@ -4,7 +4,9 @@
 use super::averaged::AveragedSystem;
 use super::backend::{self, Backend};
 use super::contacts::{Contacts, Steric};
-use super::error::{invalid, require_finite, require_positive, EngineError, Result};
+use super::error::{
+    invalid, require_finite, require_positive, unsupported, EngineError, Result, Setting,
+};
 use super::gpu::{GpuModel, GpuRun, RunOutcome, UniformSteps};
 use super::integrators::{uniform_steps, IntegratorSpec, OdeSystem, Stats, Stepper};
 use super::micro::MicroSystem;
@@ -308,7 +310,7 @@ impl Scene {
         if let Some(c) = cutoff {
             if !(c.is_finite() && c > 0.0) {
                 return Err(invalid!(
-                    "the cutoff must be a positive distance in m, got {c}; e.g. s.cutoff = 20 * 10e-6, or s.cutoff = () for every pair"
+                    "the cutoff must be a positive distance in m (e.g. 2e-4, twenty ell), got {c}; or none for every pair"
                 ));
             }
         }
@@ -379,9 +381,9 @@ impl Scene {
         let cpu_only = |what: &str| Err(format!("{what} runs on the CPU only"));
         match self.model {
             _ if self.contacts != Contacts::default() => {
-                cpu_only("contact handling (s.overlaps = \"allow\", s.steric)")
+                cpu_only("contact handling (overlaps allowed, steric repulsion)")
             }
-            Model::Averaged if self.cutoff.is_some() => cpu_only("the far-field cutoff (s.cutoff)"),
+            Model::Averaged if self.cutoff.is_some() => cpu_only("the far-field cutoff"),
             _ => Ok(()),
         }
     }
@@ -392,11 +394,25 @@ impl Scene {
             .and_then(|()| self.gpu_options_supported())
             .and_then(|()| backend::gpu_tableau(&self.integrator()).map(|_| ()));
         match self.backend {
-            Backend::Cpu => Ok((false, "s.backend = \"cpu\"".into())),
+            Backend::Cpu => Ok((false, "the cpu backend was chosen".into())),
             Backend::Gpu => {
-                fit.map_err(|e| invalid!("s.backend = \"gpu\": {e}; set s.backend = \"cpu\" or \"auto\", or s.integrator = rk4(dt)"))?;
-                let dev = super::gpu::device().map_err(|e| invalid!("s.backend = \"gpu\": {e}"))?;
-                Ok((true, format!("{} (s.backend = \"gpu\")", dev.describe())))
+                fit.map_err(|e| {
+                    unsupported(
+                        format!("the gpu backend: {e}"),
+                        &[
+                            Setting::Backend("cpu"),
+                            Setting::Backend("auto"),
+                            Setting::FixedStep,
+                        ],
+                    )
+                })?;
+                let dev = super::gpu::device().map_err(|e| {
+                    unsupported(format!("the gpu backend: {e}"), &[Setting::Backend("cpu")])
+                })?;
+                Ok((
+                    true,
+                    format!("{} (the gpu backend was chosen)", dev.describe()),
+                ))
             }
             Backend::Auto => {
                 if let Err(e) = fit {
@@ -638,7 +654,10 @@ impl Scene {
     /// The common stroke period 2π/ω; an error if the swimmers' ω differ or there are none.
     pub fn period(&self) -> Result<f64> {
         let first = self.swimmers.first().ok_or_else(|| {
-            invalid!("the scene has no swimmers, so no period; add one with s.add(dumbbell(#{{}}))")
+            unsupported(
+                "the scene has no swimmers, so no period",
+                &[Setting::AddSwimmer],
+            )
         })?;
         if let Some((i, d)) = self
             .swimmers
@@ -729,8 +748,9 @@ impl Scene {
                 );
                 Ok(sys.tensions(self.time, &self.state)[i])
             }
-            Model::Averaged => Err(invalid!(
-                "tension({i}) does not exist in the averaged model (it has no springs); set s.model = \"micro\" or \"rigid\""
+            Model::Averaged => Err(unsupported(
+                format!("tension({i}) does not exist in the averaged model (it has no springs)"),
+                &[Setting::Model("micro"), Setting::Model("rigid")],
             )),
         }
     }
@@ -800,8 +820,9 @@ impl Scene {
             )),
             Model::Rigid => {
                 if self.contacts.steric.is_some() {
-                    return Err(invalid!(
-                        "steric repulsion is not available in the rigid-stroke model (its constraint solve takes dumbbell tensions only); set s.model = \"micro\" or \"averaged\", or s.steric = ()"
+                    return Err(unsupported(
+                        "steric repulsion is not available in the rigid-stroke model (its constraint solve takes dumbbell tensions only)",
+                        &[Setting::Model("micro"), Setting::Model("averaged"), Setting::NoSteric],
                     ));
                 }
                 Box::new(RigidSystem::new(
@@ -828,8 +849,9 @@ impl Scene {
         if let Some(first) = self.swimmers.first() {
             for (i, d) in self.swimmers.iter().enumerate() {
                 if d.omega != first.omega || d.lambda != first.lambda || d.ell != first.ell {
-                    return Err(invalid!(
-                        "the averaged model needs equal omega, lambda and ell for all swimmers (swimmer {i} differs from swimmer 0); use s.model = \"micro\" for mixed strokes"
+                    return Err(unsupported(
+                        format!("the averaged model needs equal omega, lambda and ell for all swimmers (swimmer {i} differs from swimmer 0)"),
+                        &[Setting::Model("micro")],
                     ));
                 }
             }
@@ -969,13 +991,17 @@ impl Scene {
             );
             let done = match outcome {
                 Err(e) => {
-                    break Err(invalid!(
-                        "the GPU run failed: {e}; the scene keeps its state at t = {:.6e} s; use s.backend = \"cpu\"",
-                        self.time
+                    break Err(unsupported(
+                        format!(
+                            "the GPU run failed: {e}; the scene keeps its state at t = {:.6e} s",
+                            self.time
+                        ),
+                        &[Setting::Backend("cpu")],
                     ))
                 }
                 Ok(RunOutcome::Done) => n,
-                Ok(RunOutcome::Failed { steps_done }) | Ok(RunOutcome::Interrupted { steps_done }) => steps_done,
+                Ok(RunOutcome::Failed { steps_done })
+                | Ok(RunOutcome::Interrupted { steps_done }) => steps_done,
             };
             self.time = if done == n {
                 t_end
@@ -1044,6 +1070,7 @@ impl Scene {
                         swimmer: f.problem.swimmer,
                         cause: f.problem.cause,
                         hint: f.problem.hint,
+                        fixes: f.problem.fixes,
                     });
                     break;
                 }

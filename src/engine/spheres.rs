@@ -213,7 +213,15 @@ pub(crate) fn overlap_problem(gap: f64, a: usize, b: usize) -> Problem {
         hint: if sa == sb {
             "use a smaller time step (an explicit step above its stability limit collapses the spring), or a shorter stroke".into()
         } else {
-            "start the swimmers further apart or take a smaller time step; or let swimmers overlap (s.overlaps = \"allow\") or repel each other (s.steric = #{ range: 1e-7, stiffness: 1e-3 })".into()
+            "start the swimmers further apart or take a smaller time step".into()
+        },
+        fixes: if sa == sb {
+            Vec::new()
+        } else {
+            vec![
+                crate::engine::error::Setting::AllowOverlaps,
+                crate::engine::error::Setting::Steric,
+            ]
         },
     }
 }

@@ -1,5 +1,6 @@
 //! Conversions between Rhai values and engine values, with errors that say what was expected.
 
+use crate::engine::error::Setting;
 use crate::engine::EngineError;
 use nalgebra::Vector3;
 use rhai::{Array, Dynamic, EvalAltResult, Position, FLOAT, INT};
@@ -12,9 +13,55 @@ pub fn script_error(msg: impl Into<String>) -> Box<EvalAltResult> {
     EvalAltResult::ErrorRuntime(Dynamic::from(msg.into()), Position::NONE).into()
 }
 
-/// Engine errors become script errors carrying the engine's message.
+/// The script line that makes a setting an engine error names as its fix.
+pub fn setting_in_script(s: &Setting) -> String {
+    match s {
+        Setting::Backend(b) => format!("s.backend = \"{b}\""),
+        Setting::Model(m) => format!("s.model = \"{m}\""),
+        Setting::FixedStep => "s.integrator = rk4(dt)".into(),
+        Setting::DefaultIntegrator => "s.integrator = \"default\"".into(),
+        Setting::StableStep => "a step dt below ~2.8 / s.stiff_rate".into(),
+        Setting::NoSteric => "s.steric = ()".into(),
+        Setting::Steric => "s.steric = #{ range: 1e-7, stiffness: 1e-3 }".into(),
+        Setting::AllowOverlaps => "s.overlaps = \"allow\"".into(),
+        Setting::NoCutoff => "s.cutoff = ()".into(),
+        Setting::AddSwimmer => "s.add(dumbbell(#{}))".into(),
+        Setting::Lattice => "s.add_at(d, lattice::cubic(nx, ny, nz, spacing))".into(),
+    }
+}
+
+fn fixes_in_script(fixes: &[Setting]) -> String {
+    fixes
+        .iter()
+        .map(setting_in_script)
+        .collect::<Vec<_>>()
+        .join(" or ")
+}
+
+/// An engine error as a script user reads it: the engine's message, its fixes as script lines.
+pub fn engine_message(e: &EngineError) -> String {
+    match e {
+        EngineError::Unsupported { problem, fixes } => {
+            format!("{problem}; use {}", fixes_in_script(fixes))
+        }
+        EngineError::StepFailed {
+            time,
+            last_good,
+            cause,
+            hint,
+            fixes,
+            ..
+        } if !fixes.is_empty() => format!(
+            "the run stopped at t = {time:.6e} s: {cause}; the scene keeps the last good state (t = {last_good:.6e} s). Likely fix: {hint}; or use {}",
+            fixes_in_script(fixes)
+        ),
+        other => other.to_string(),
+    }
+}
+
+/// Engine errors become script errors carrying the engine's message in script terms.
 pub fn from_engine(e: EngineError) -> Box<EvalAltResult> {
-    script_error(e.to_string())
+    script_error(engine_message(&e))
 }
 
 /// Map an engine result into a script result.

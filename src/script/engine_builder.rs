@@ -57,15 +57,22 @@ pub fn run_source(name: &str, source: &str, scope: &mut Scope) -> Result<(), Str
     })
 }
 
-/// Run script text with `--set` constants: each is a constant of the script and the value of
-/// `param(name, default)`; a name the script never reads, or hides with its own `let`, is an
-/// error before anything runs.
-pub fn run_source_with(name: &str, source: &str, sets: &params::Sets) -> Result<(), String> {
+/// Run script text with [`params::RunOptions`]: `quick()` answers `options.quick`; each `--set`
+/// value is a constant of the script and the value of `param(name, default)`; a name the script
+/// never reads, or hides with its own `let`, is an error before anything runs.
+pub fn run_source_with(
+    name: &str,
+    source: &str,
+    options: &params::RunOptions,
+) -> Result<(), String> {
     let source = strip_bom(source);
+    let sets = &options.sets;
+    let quick = options.quick;
     guard(name, || {
         interrupt::clear();
         let mut engine = engine();
         params::register(&mut engine, sets);
+        engine.register_fn("quick", move || quick || util_api::quick());
         let mut scope = Scope::new();
         for (n, v) in sets {
             scope.push_constant_dynamic(n.clone(), v.clone());
@@ -129,11 +136,11 @@ pub fn run_file(path: &std::path::Path, scope: &mut Scope) -> Result<(), String>
     run_source(&path.display().to_string(), &source, scope)
 }
 
-/// Run a script file with `--set` constants (see [`run_source_with`]).
-pub fn run_file_with(path: &std::path::Path, sets: &params::Sets) -> Result<(), String> {
+/// Run a script file with [`params::RunOptions`] (see [`run_source_with`]).
+pub fn run_file_with(path: &std::path::Path, options: &params::RunOptions) -> Result<(), String> {
     let source =
         read_text(path, MAX_SOURCE_BYTES, "script").map_err(|e| format!("error: {e}\n"))?;
-    run_source_with(&path.display().to_string(), &source, sets)
+    run_source_with(&path.display().to_string(), &source, options)
 }
 
 /// Evaluate one expression (`swimlab -e`) and return its value shown as the shell shows it.

@@ -6,6 +6,7 @@ mod csv_api;
 pub mod docs;
 mod dumbbell_api;
 mod engine_builder;
+pub mod figures;
 mod float_cmp;
 mod integrator_api;
 pub mod interrupt;
@@ -23,7 +24,7 @@ pub mod stdlib;
 mod sweep_api;
 mod util_api;
 
-pub use convert::{script_error, ScriptResult};
+pub use convert::{engine_message, script_error, setting_in_script, ScriptResult};
 
 /// The documented name closest to `word`, for "did you mean".
 pub fn suggest_name(word: &str) -> Option<&'static str> {

@@ -11,6 +11,43 @@ use rhai::{Dynamic, Engine, Position, AST};
 /// The `--set` values of one run, in command-line order.
 pub type Sets = [(String, Dynamic)];
 
+/// How `swimlab run` (and `make-figures`) runs a script: its quick variant or not, and the
+/// `--set` constants.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// What `quick()` returns (also true when SWIMLAB_QUICK=1 is set).
+    pub quick: bool,
+    /// The `--set NAME=VALUE` constants.
+    pub sets: Vec<(String, Dynamic)>,
+}
+
+/// Parse `NAME=VALUE` into a Rhai constant.
+pub fn parse_set(item: &str) -> Result<(String, Dynamic), String> {
+    let (name, value) = item
+        .split_once('=')
+        .ok_or_else(|| format!("error: --set {item}: expected NAME=VALUE, such as --set D=10"))?;
+    let valid = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_alphanumeric() || c == '_');
+    if !valid {
+        return Err(format!(
+            "error: --set {item}: \"{name}\" is not a valid variable name (letters, digits, _)"
+        ));
+    }
+    let v = if let Ok(i) = value.parse::<i64>() {
+        Dynamic::from_int(i)
+    } else if let Ok(f) = value.parse::<f64>() {
+        Dynamic::from_float(f)
+    } else if let Ok(b) = value.parse::<bool>() {
+        Dynamic::from_bool(b)
+    } else {
+        Dynamic::from(value.to_string())
+    };
+    Ok((name.to_string(), v))
+}
+
 /// Register `param(name, default)`: the `--set` value of `name` if one was given, else `default`.
 pub fn register(engine: &mut Engine, sets: &Sets) {
     let sets: Vec<(String, Dynamic)> = sets.to_vec();

@@ -298,7 +298,9 @@ pub fn register(engine: &mut Engine) {
                     .map_err(|_| unknown_choice("backend", &name, &["cpu", "gpu", "auto"]))?;
                 if b == Backend::Gpu {
                     crate::engine::gpu::device().map_err(|e| {
-                        script_error(format!("s.backend = \"gpu\": {e}"))
+                        script_error(format!(
+                            "s.backend = \"gpu\": {e}; use s.backend = \"cpu\" or \"auto\""
+                        ))
                     })?;
                 }
                 s.borrow_mut().set_backend(b);

@@ -106,17 +106,15 @@ fn acquire() -> Result<GpuDevice, String> {
             .max_by_key(|a| rank(a.get_info().device_type));
         (best, seen)
     })
-    .map_err(|_| {
-        "the GPU driver failed while listing adapters; use s.backend = \"cpu\"".to_string()
-    })?;
+    .map_err(|_| "the GPU driver failed while listing adapters".to_string())?;
     let adapter = match found {
         (Some(a), _) => a,
         (None, seen) if seen.is_empty() => {
-            return Err("no GPU adapter found (no Vulkan, Metal or DX12 driver answered); install a driver (on Debian: mesa-vulkan-drivers libvulkan1) or use s.backend = \"cpu\"".into())
+            return Err("no GPU adapter found (no Vulkan, Metal or DX12 driver answered); install a driver (on Debian: mesa-vulkan-drivers libvulkan1) or run on the CPU".into())
         }
         (None, seen) => {
             return Err(format!(
-                "no GPU adapter offers f64 in shaders (SHADER_F64), which swimlab needs: the drift per period is ~1e-6 of the stroke and f32 cannot carry it; adapters seen: {}; use s.backend = \"cpu\"",
+                "no GPU adapter offers f64 in shaders (SHADER_F64), which swimlab needs: the drift per period is ~1e-6 of the stroke and f32 cannot carry it; adapters seen: {}",
                 seen.join(", ")
             ))
         }
@@ -125,7 +123,7 @@ fn acquire() -> Result<GpuDevice, String> {
     let offered = adapter.limits();
     if offered.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS {
         return Err(format!(
-            "the GPU adapter {} allows {} storage buffers per kernel, swimlab's kernels bind {STORAGE_BUFFERS}; use s.backend = \"cpu\"",
+            "the GPU adapter {} allows {} storage buffers per kernel, swimlab's kernels bind {STORAGE_BUFFERS}",
             describe(&info),
             offered.max_storage_buffers_per_shader_stage
         ));
@@ -144,12 +142,7 @@ fn acquire() -> Result<GpuDevice, String> {
         memory_hints: wgpu::MemoryHints::Performance,
         trace: wgpu::Trace::Off,
     }))
-    .map_err(|e| {
-        format!(
-            "the GPU adapter {} refused a device: {e}; use s.backend = \"cpu\"",
-            describe(&info)
-        )
-    })?;
+    .map_err(|e| format!("the GPU adapter {} refused a device: {e}", describe(&info)))?;
     let errors = Arc::new(Mutex::new(Vec::new()));
     let sink = errors.clone();
     device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {

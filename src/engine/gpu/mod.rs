@@ -95,7 +95,7 @@ fn compile(dev: &GpuDevice) -> Result<Kernels, String> {
     match pollster::block_on(scope.pop()) {
         None => Ok(kernels),
         Some(e) => Err(format!(
-            "the GPU kernels did not compile on {}: {e}; use s.backend = \"cpu\"",
+            "the GPU kernels did not compile on {}: {e}",
             dev.describe()
         )),
     }

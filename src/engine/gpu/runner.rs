@@ -190,7 +190,7 @@ impl GpuRun {
         let read_control = readback(&dev, "read control", std::mem::size_of::<Control>());
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(format!(
-                "the GPU has no room for {n} swimmers: {e}; use fewer swimmers or s.backend = \"cpu\""
+                "the GPU has no room for {n} swimmers: {e}; use fewer swimmers or the CPU"
             ));
         }
         Ok(GpuRun {

@@ -206,6 +206,7 @@ impl Stepper for Rosenbrock {
                     swimmer: None,
                     cause: format!("Jacobian blocks of size {bs} do not tile a state of size {n}"),
                     hint: "this is a bug in the model; use rk4 or dopri5 meanwhile".into(),
+                    fixes: Vec::new(),
                 },
             });
         }

@@ -1,5 +1,6 @@
 //! The contract between models and integrators.
 
+use crate::engine::error::Setting;
 use serde::{Deserialize, Serialize};
 
 /// A first-order system dy/dt = f(t, y) with the hooks the integrators need.
@@ -36,6 +37,8 @@ pub struct Problem {
     pub cause: String,
     /// What to change.
     pub hint: String,
+    /// Settings that would avoid it.
+    pub fixes: Vec<crate::engine::error::Setting>,
 }
 
 /// A step that could not be completed; the caller's state is unchanged.
@@ -109,7 +112,9 @@ pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<
             problem: Problem {
                 swimmer: None,
                 cause: format!("state component {i} became NaN or infinite"),
-                hint: "use a smaller time step (the springs are stiff: RK4 needs dt below ~2.8 / s.stiff_rate) or the adaptive dopri5".into(),
+                hint: "use a smaller time step (the springs are stiff) or an adaptive integrator"
+                    .into(),
+                fixes: vec![Setting::StableStep, Setting::DefaultIntegrator],
             },
         });
     }
@@ -129,6 +134,7 @@ pub(crate) fn tolerance_failure(time: f64, h: f64, rejects: u32) -> StepFailure 
             ),
             hint: "loosen the tolerance, or check the scene for NaN or nearly touching spheres"
                 .into(),
+            fixes: Vec::new(),
         },
     }
 }

@@ -1,0 +1,131 @@
+//! `swimlab bench ...`: each benchmark's tables printed and written as CSV, with its pictures,
+//! under out/bench/. The command line only names the benchmark.
+
+use super::{backends, pairs, plots, scaling, stability, work_precision};
+use crate::engine::Model;
+
+/// The benchmarks `swimlab bench` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Every integrator on the Fig-1 pairs: error against work, Pareto front.
+    WorkPrecision,
+    /// Largest stable step of each explicit method.
+    Stability,
+    /// CPU against GPU per RK4 step against size.
+    Backends,
+    /// The CPU pair kernel's interactions per second.
+    Pairs,
+    /// Cost per period against the number of swimmers.
+    Scaling,
+}
+
+/// Run one benchmark, print its tables and write its CSV and pictures under out/bench/.
+pub fn run(which: Kind, quick: bool) -> Result<(), String> {
+    let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
+    match which {
+        Kind::WorkPrecision => {
+            let (periods, repeats) = if quick { (5.0, 1) } else { (100.0, 5) };
+            for (label, models, file) in [
+                (
+                    "microscopic model (spring and rigid-stroke)",
+                    vec![Model::Micro, Model::Rigid],
+                    "work_precision_micro.csv",
+                ),
+                (
+                    "averaged model",
+                    vec![Model::Averaged],
+                    "work_precision_averaged.csv",
+                ),
+            ] {
+                let points = work_precision::run(&models, periods, repeats, quick);
+                let t = work_precision::table(&points);
+                println!("\n{label}, {periods} periods (errors relative to the converged reference; * = Pareto front):\n{}", t.render());
+                println!(
+                    "\nfastest method per error level of the drift:\n{}",
+                    work_precision::winners(&points).render()
+                );
+                t.write_csv(&std::path::Path::new("out/bench").join(file))
+                    .map_err(io)?;
+                for (k, (config, ..)) in work_precision::CONFIGS.iter().enumerate() {
+                    if let Some(f) = plots::work_precision(&points, config) {
+                        let png = format!("out/bench/{}_{k}.png", file.trim_end_matches(".csv"));
+                        f.save(std::path::Path::new(&png))?;
+                        println!("picture: {png}");
+                    }
+                }
+            }
+            println!("\nCSV written to out/bench/");
+        }
+        Kind::Stability => {
+            let rows = stability::run(quick);
+            let t = stability::table(&rows);
+            println!("largest stable step (bisection on dt*rate, 4 periods of an isolated asymmetric dumbbell):\n{}", t.render());
+            t.write_csv(std::path::Path::new("out/bench/stability.csv"))
+                .map_err(io)?;
+            println!("\nCSV written to out/bench/stability.csv");
+        }
+        Kind::Pairs => {
+            let n = 4096;
+            let t = pairs::run(n, if quick { 3 } else { 11 });
+            println!(
+                "RPY product u_i = sum_j H_ij F_j, N = {n} spheres, N(N-1) interactions per product, vector unit {} (medians):\n{}",
+                crate::engine::pairs::vector_unit(),
+                t.render()
+            );
+            t.write_csv(std::path::Path::new("out/bench/pairs.csv"))
+                .map_err(io)?;
+            println!("\nCSV written to out/bench/pairs.csv");
+        }
+        Kind::Scaling => {
+            let rows = scaling::run(if quick { 256 } else { 4096 })?;
+            let t = scaling::table(&rows);
+            println!(
+                "cost per stroke period on the CPU ({} threads; lattice scenes, RK4: micro at its default step, averaged one step per period):\n{}",
+                rayon::current_num_threads(),
+                t.render()
+            );
+            for m in [Model::Micro, Model::Averaged] {
+                for from in [2, 256] {
+                    if let Some((k, c)) = scaling::fit(&rows, m, from) {
+                        println!(
+                            "{}: cost per period ~ {c:.2e} s * S^{k:.2} (fit over S >= {from})",
+                            m.name()
+                        );
+                    }
+                }
+            }
+            t.write_csv(std::path::Path::new("out/bench/scaling.csv"))
+                .map_err(io)?;
+            plots::scaling(&rows).save(std::path::Path::new("out/bench/scaling.png"))?;
+            println!("picture: out/bench/scaling.png");
+            println!("\nCSV written to out/bench/scaling.csv");
+        }
+        Kind::Backends => {
+            match crate::engine::gpu::device() {
+                Ok(d) => println!("GPU adapter: {}", d.describe()),
+                Err(e) => println!("GPU: {e}"),
+            }
+            let rows = backends::run(if quick { 1024 } else { 16384 });
+            let t = backends::table(&rows);
+            println!("wall time per RK4 step (one process, medians not taken; '-' = over the time budget or no adapter):\n{}", t.render());
+            for m in [Model::Micro, Model::Averaged] {
+                match backends::measured_crossover(&rows, m) {
+                    Some(n) => println!("{}: the GPU is faster from {n} in this table", m.name()),
+                    None => println!(
+                        "{}: the GPU is not faster at any size in this table",
+                        m.name()
+                    ),
+                }
+            }
+            for (m, detail) in backends::auto_thresholds() {
+                println!("auto calibration, {}: {detail}", m.name());
+            }
+            t.write_csv(std::path::Path::new("out/bench/backends.csv"))
+                .map_err(io)?;
+            plots::backends(&rows).save(std::path::Path::new("out/bench/backends.png"))?;
+            println!("picture: out/bench/backends.png");
+            println!("\nCSV written to out/bench/backends.csv");
+        }
+    }
+    Ok(())
+}
