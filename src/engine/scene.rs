@@ -18,6 +18,9 @@ use super::swimmer::{unit_direction, Dumbbell};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+mod save;
+pub use save::{MAX_TIME_IN_PERIODS, SAVE_FORMAT};
+
 /// Water at room temperature (Pa s), the paper's μ.
 pub const DEFAULT_MU: f64 = 1e-3;
 
@@ -34,22 +37,9 @@ pub const DEFAULT_RIGID_RTOL: f64 = 1e-7;
 /// Default tolerance of the averaged model's adaptive integrator.
 pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 
-/// The latest time a scene may hold, in stroke periods: at 1e9 periods f64 still resolves the
-/// phase to ~1e-7 of a period (and a default microscopic step to ~1e-4 of itself).
-pub const MAX_TIME_IN_PERIODS: f64 = 1e9;
-
 /// Most steps one run of a fixed-step integrator may take (~1e5 s, a day, at 1 µs a step): a
 /// longer run is refused with the numbers before it starts; split it into several runs.
 pub const MAX_FIXED_STEPS_PER_RUN: f64 = 1e11;
-
-/// Version of the JSON layout written by [`Scene::to_json`].
-pub const SAVE_FORMAT: u32 = 1;
-
-#[derive(Serialize)]
-struct SavedScene<'a> {
-    format: u32,
-    scene: &'a Scene,
-}
 
 /// The swimmers, the fluid and the numerics of one simulation.
 ///
@@ -483,42 +473,7 @@ impl Scene {
         Ok(())
     }
 
-    /// The scene as JSON (swimmers, phases, model, integrator, time, state), exactly round-tripping.
-    pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string_pretty(&SavedScene {
-            format: SAVE_FORMAT,
-            scene: self,
-        })
-        .map_err(|e| invalid!("cannot serialise the scene: {e}"))
-    }
-
-    /// A scene from [`Scene::to_json`] output.
-    pub fn from_json(text: &str) -> Result<Scene> {
-        #[derive(Deserialize)]
-        struct Loaded {
-            format: u32,
-            scene: Scene,
-        }
-        let loaded: Loaded =
-            serde_json::from_str(text).map_err(|e| invalid!("not a swimlab scene file: {e}"))?;
-        if loaded.format != SAVE_FORMAT {
-            return Err(invalid!(
-                "scene file format {} is not supported (this swimlab reads format {SAVE_FORMAT})",
-                loaded.format
-            ));
-        }
-        let s = loaded.scene;
-        let n = s.swimmers.len();
-        if s.base.len() != n || s.state.len() != STATE_PER_SWIMMER * n {
-            return Err(invalid!(
-                "scene file is inconsistent: {n} swimmers but {} base positions and {} state values",
-                s.base.len(),
-                s.state.len()
-            ));
-        }
-        s.validate()?;
-        Ok(s)
-    }
+    // ----- reading ---------------------------------------------------------------------------
 
     /// The smallest gap |x_α − x_β| − a_α − a_β over all pairs of spheres (m) and the two spheres
     /// (sphere α belongs to swimmer α/2, the a1 sphere first); `None` with fewer than two spheres.
@@ -538,92 +493,6 @@ impl Scene {
         }
         super::pairs::min_gap(&soa, &radii, n >= 256)
     }
-
-    /// Check a scene read from a file as the setters check their values: a file that was edited
-    /// by hand, truncated or written by something else is refused with the value at fault.
-    fn validate(&self) -> Result<()> {
-        require_positive("mu", self.mu, "Pa s")?;
-        match self.integrator {
-            Some(IntegratorSpec::Euler { dt }) => IntegratorSpec::euler(dt).map(|_| ())?,
-            Some(IntegratorSpec::Rk4 { dt }) => IntegratorSpec::rk4(dt).map(|_| ())?,
-            Some(IntegratorSpec::Dopri5 { rtol }) => IntegratorSpec::dopri5(rtol).map(|_| ())?,
-            Some(IntegratorSpec::Rosw { rtol }) => IntegratorSpec::rosw(rtol).map(|_| ())?,
-            None => {}
-        }
-        if let Some(st) = self.contacts.steric {
-            Steric::new(st.range, st.stiffness)?;
-        }
-        if let Some(c) = self.cutoff {
-            let mut probe = Scene::new();
-            probe.set_cutoff(Some(c))?;
-        }
-        for (i, d) in self.swimmers.iter().enumerate() {
-            d.validate().map_err(|e| invalid!("swimmer {i}: {e}"))?;
-        }
-        require_finite("time", self.time)?;
-        if self.time < 0.0 {
-            return Err(invalid!(
-                "time is {:e} s; a scene's time starts at 0 and only grows",
-                self.time
-            ));
-        }
-        let t_max = self
-            .swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(1.0, f64::max)
-            * MAX_TIME_IN_PERIODS;
-        if self.time > t_max {
-            return Err(invalid!(
-                "time is {:e} s, beyond {MAX_TIME_IN_PERIODS:e} stroke periods ({t_max:e} s), where f64 no longer resolves the stroke; reset the time to 0 (the state is what matters)",
-                self.time
-            ));
-        }
-        for (i, b) in self.base.iter().enumerate() {
-            if !b.iter().all(|x| x.is_finite()) {
-                return Err(invalid!("base position of swimmer {i} is not finite"));
-            }
-        }
-        if let Some(k) = self.state.iter().position(|v| !v.is_finite()) {
-            return Err(invalid!(
-                "state value {k} (swimmer {}) is not finite",
-                k / STATE_PER_SWIMMER
-            ));
-        }
-        for i in 0..self.count() {
-            let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
-            let len = v.norm();
-            match self.model {
-                Model::Micro if len <= 0.0 => {
-                    return Err(invalid!(
-                        "swimmer {i}: its dumbbell vector X2 - X1 is zero; a dumbbell needs two distinct spheres"
-                    ))
-                }
-                Model::Averaged | Model::Rigid if (len - 1.0).abs() > 1e-9 => {
-                    return Err(invalid!(
-                        "swimmer {i}: its orientation N has length {len}, not 1; in the {} model the state holds the unit vector N",
-                        self.model.name()
-                    ))
-                }
-                _ => {}
-            }
-        }
-        if let Some((gap, a, b)) = self.closest_spheres() {
-            let same = a / 2 == b / 2;
-            if gap <= 0.0 && (same || !self.contacts.allow_overlap) {
-                return Err(invalid!(
-                    "spheres {a} and {b} (swimmers {} and {}) overlap by {:.3e} m; move them apart{}",
-                    a / 2,
-                    b / 2,
-                    -gap,
-                    if same { "" } else { ", or allow overlaps (\"overlaps\": allow)" }
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    // ----- reading ---------------------------------------------------------------------------
 
     /// Number of swimmers.
     pub fn count(&self) -> usize {

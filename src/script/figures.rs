@@ -44,8 +44,12 @@ pub fn make_figures(quick: bool, out: Option<&std::path::Path>) -> Result<(), St
         println!("{name}: {:.1} s", start.elapsed().as_secs_f64());
     }
     if let Some(dir) = out {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create folder {}: {e}; choose a folder you can write to", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|e| {
+            format!(
+                "cannot create folder {}: {e}; choose a folder you can write to",
+                dir.display()
+            )
+        })?;
         let entries =
             std::fs::read_dir("out/paper").map_err(|e| format!("cannot read out/paper: {e}"))?;
         for entry in entries.flatten() {
@@ -60,4 +64,3 @@ pub fn make_figures(quick: bool, out: Option<&std::path::Path>) -> Result<(), St
     }
     Ok(())
 }
-

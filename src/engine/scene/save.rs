@@ -1,0 +1,147 @@
+//! Saving and loading a scene: JSON that round-trips exactly, and on load every value checked as
+//! the setters check it (a file edited by hand, truncated or written by something else is refused
+//! with the value at fault).
+
+use super::super::contacts::Steric;
+use super::super::error::{invalid, require_finite, require_positive, Result};
+use super::super::integrators::IntegratorSpec;
+use super::super::model::{vec3, Model, STATE_PER_SWIMMER};
+use super::super::swimmer::Dumbbell;
+use super::Scene;
+use serde::{Deserialize, Serialize};
+
+/// The latest time a scene may hold, in stroke periods: at 1e9 periods f64 still resolves the
+/// phase to ~1e-7 of a period (and a default microscopic step to ~1e-4 of itself).
+pub const MAX_TIME_IN_PERIODS: f64 = 1e9;
+
+/// Version of the JSON layout written by [`Scene::to_json`].
+pub const SAVE_FORMAT: u32 = 1;
+
+#[derive(Serialize)]
+struct SavedScene<'a> {
+    format: u32,
+    scene: &'a Scene,
+}
+
+impl Scene {
+    /// The scene as JSON (swimmers, phases, model, integrator, time, state), exactly round-tripping.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(&SavedScene {
+            format: SAVE_FORMAT,
+            scene: self,
+        })
+        .map_err(|e| invalid!("cannot serialise the scene: {e}"))
+    }
+
+    /// A scene from [`Scene::to_json`] output.
+    pub fn from_json(text: &str) -> Result<Scene> {
+        #[derive(Deserialize)]
+        struct Loaded {
+            format: u32,
+            scene: Scene,
+        }
+        let loaded: Loaded =
+            serde_json::from_str(text).map_err(|e| invalid!("not a swimlab scene file: {e}"))?;
+        if loaded.format != SAVE_FORMAT {
+            return Err(invalid!(
+                "scene file format {} is not supported (this swimlab reads format {SAVE_FORMAT})",
+                loaded.format
+            ));
+        }
+        let s = loaded.scene;
+        let n = s.swimmers.len();
+        if s.base.len() != n || s.state.len() != STATE_PER_SWIMMER * n {
+            return Err(invalid!(
+                "scene file is inconsistent: {n} swimmers but {} base positions and {} state values",
+                s.base.len(),
+                s.state.len()
+            ));
+        }
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Check a scene read from a file as the setters check their values: a file that was edited
+    /// by hand, truncated or written by something else is refused with the value at fault.
+    pub(super) fn validate(&self) -> Result<()> {
+        require_positive("mu", self.mu, "Pa s")?;
+        match self.integrator {
+            Some(IntegratorSpec::Euler { dt }) => IntegratorSpec::euler(dt).map(|_| ())?,
+            Some(IntegratorSpec::Rk4 { dt }) => IntegratorSpec::rk4(dt).map(|_| ())?,
+            Some(IntegratorSpec::Dopri5 { rtol }) => IntegratorSpec::dopri5(rtol).map(|_| ())?,
+            Some(IntegratorSpec::Rosw { rtol }) => IntegratorSpec::rosw(rtol).map(|_| ())?,
+            None => {}
+        }
+        if let Some(st) = self.contacts.steric {
+            Steric::new(st.range, st.stiffness)?;
+        }
+        if let Some(c) = self.cutoff {
+            let mut probe = Scene::new();
+            probe.set_cutoff(Some(c))?;
+        }
+        for (i, d) in self.swimmers.iter().enumerate() {
+            d.validate().map_err(|e| invalid!("swimmer {i}: {e}"))?;
+        }
+        require_finite("time", self.time)?;
+        if self.time < 0.0 {
+            return Err(invalid!(
+                "time is {:e} s; a scene's time starts at 0 and only grows",
+                self.time
+            ));
+        }
+        let t_max = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(1.0, f64::max)
+            * MAX_TIME_IN_PERIODS;
+        if self.time > t_max {
+            return Err(invalid!(
+                "time is {:e} s, beyond {MAX_TIME_IN_PERIODS:e} stroke periods ({t_max:e} s), where f64 no longer resolves the stroke; reset the time to 0 (the state is what matters)",
+                self.time
+            ));
+        }
+        for (i, b) in self.base.iter().enumerate() {
+            if !b.iter().all(|x| x.is_finite()) {
+                return Err(invalid!("base position of swimmer {i} is not finite"));
+            }
+        }
+        if let Some(k) = self.state.iter().position(|v| !v.is_finite()) {
+            return Err(invalid!(
+                "state value {k} (swimmer {}) is not finite",
+                k / STATE_PER_SWIMMER
+            ));
+        }
+        for i in 0..self.count() {
+            let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
+            let len = v.norm();
+            match self.model {
+                Model::Micro if len <= 0.0 => {
+                    return Err(invalid!(
+                        "swimmer {i}: its dumbbell vector X2 - X1 is zero; a dumbbell needs two distinct spheres"
+                    ))
+                }
+                Model::Averaged | Model::Rigid if (len - 1.0).abs() > 1e-9 => {
+                    return Err(invalid!(
+                        "swimmer {i}: its orientation N has length {len}, not 1; in the {} model the state holds the unit vector N",
+                        self.model.name()
+                    ))
+                }
+                _ => {}
+            }
+        }
+        if let Some((gap, a, b)) = self.closest_spheres() {
+            let same = a / 2 == b / 2;
+            if gap <= 0.0 && (same || !self.contacts.allow_overlap) {
+                return Err(invalid!(
+                    "spheres {a} and {b} (swimmers {} and {}) overlap by {:.3e} m; move them apart{}",
+                    a / 2,
+                    b / 2,
+                    -gap,
+                    if same { "" } else { ", or allow overlaps (\"overlaps\": allow)" }
+                ));
+            }
+        }
+        Ok(())
+    }
+}
