@@ -7,8 +7,8 @@ use super::error::{invalid, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// Create the folder that will hold `path`.
-fn ensure_parent(path: &Path) -> Result<()> {
+/// Create the folder that will hold `path`, with an error that names the fix.
+pub fn ensure_parent(path: &Path) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| {
             invalid!(

@@ -286,14 +286,7 @@ impl Figure {
     pub fn save(&self, path: &std::path::Path) -> Result<(), String> {
         self.validate()?;
         let format = Format::of(path)?;
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| {
-                format!(
-                    "cannot create folder {}: {e}; choose a path in a folder you can write to",
-                    dir.display()
-                )
-            })?;
-        }
+        crate::engine::files::ensure_parent(path).map_err(|e| e.to_string())?;
         render::figure(self, path, format)
     }
 

@@ -129,14 +129,7 @@ pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<()
         ));
     }
     let names = ["x [µm]", "y [µm]", "z [µm]"];
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            format!(
-                "cannot create folder {}: {e}; choose a path in a folder you can write to",
-                dir.display()
-            )
-        })?;
-    }
+    crate::engine::files::ensure_parent(path).map_err(|e| e.to_string())?;
     render::scene(
         &ScenePicture {
             title: &opts.title,
