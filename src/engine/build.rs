@@ -1,6 +1,7 @@
 //! Scene builders: random suspensions and lattices, seeded and reproducible.
 
 use super::error::{invalid, require_positive, Result};
+use super::model::Model;
 use super::scene::Scene;
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
@@ -121,4 +122,21 @@ pub fn random_suspension(
         }
     }
     Ok(())
+}
+
+/// A cubic lattice of `swimmers` Fig-1 swimmers (symmetric, spacing 3ℓ, along x, phases spread
+/// over the period) for timings: every pair interacts.
+pub fn lattice_scene(swimmers: usize, model: Model) -> Result<Scene> {
+    let mut s = Scene::new();
+    s.set_model(model);
+    let d = Dumbbell::default();
+    let side = (swimmers as f64).cbrt().ceil() as usize;
+    let spacing = 3.0 * d.ell;
+    for i in 0..swimmers {
+        let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
+        let phase = (i as f64 * 0.7) % (2.0 * std::f64::consts::PI);
+        let c = Vector3::new(x as f64, y as f64, z as f64) * spacing;
+        s.add(Dumbbell { phase, ..d }, c, Vector3::x())?;
+    }
+    Ok(s)
 }
