@@ -1,0 +1,137 @@
+//! src/README.md's table is the map a newcomer reads first: every engine module has a row, and
+//! its "may import" column lists every other engine module the file (with its child modules)
+//! uses. `error` is open to all. Arrows that drift from the code fail here.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// Top-level engine modules: `engine/x.rs` and `engine/x/` (a folder with mod.rs).
+fn engine_modules() -> BTreeSet<String> {
+    std::fs::read_dir(Path::new(ROOT).join("src/engine"))
+        .unwrap()
+        .flatten()
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if e.path().is_dir() {
+                e.path().join("mod.rs").exists().then_some(name)
+            } else {
+                name.strip_suffix(".rs")
+                    .filter(|n| *n != "mod")
+                    .map(str::to_string)
+            }
+        })
+        .collect()
+}
+
+/// The engine modules named in `path` (outside comments) through `crate::engine::x` or a
+/// `super::` chain that climbs to the engine.
+fn imports(path: &Path, depth: usize, modules: &BTreeSet<String>) -> BTreeSet<String> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut out = BTreeSet::new();
+    for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+        let mut rest = line;
+        while let Some(k) = rest
+            .find("super::")
+            .or_else(|| rest.find("crate::engine::"))
+        {
+            let tail = &rest[k..];
+            let (ups, after) = if let Some(a) = tail.strip_prefix("crate::engine::") {
+                (depth, a)
+            } else {
+                let mut t = tail;
+                let mut n = 0;
+                while let Some(a) = t.strip_prefix("super::") {
+                    n += 1;
+                    t = a;
+                }
+                (n, t)
+            };
+            let name: String = after
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if ups == depth && modules.contains(&name) {
+                out.insert(name);
+            }
+            rest = &tail[1..];
+        }
+    }
+    out
+}
+
+fn rs_files(dir: &Path, out: &mut Vec<(std::path::PathBuf, usize)>, depth: usize) {
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            rs_files(&p, out, depth + 1);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            // engine/x.rs sits one module below the engine, engine/x/y.rs two, ...
+            let d = if p.file_name().is_some_and(|n| n == "mod.rs") {
+                depth
+            } else {
+                depth + 1
+            };
+            out.push((p, d));
+        }
+    }
+}
+
+#[test]
+fn the_may_import_column_of_src_readme_is_the_truth() {
+    let modules = engine_modules();
+    let readme = std::fs::read_to_string(Path::new(ROOT).join("src/README.md")).unwrap();
+    let mut allowed: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for line in readme.lines() {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        if cells.len() < 5 {
+            continue;
+        }
+        let path = cells[1].trim_matches('`');
+        let Some(rest) = path.strip_prefix("engine/") else {
+            continue;
+        };
+        let name = rest.trim_end_matches('/').trim_end_matches(".rs");
+        if !modules.contains(name) {
+            continue;
+        }
+        let list = cells[3]
+            .split(',')
+            .map(|w| w.trim().to_string())
+            .filter(|w| !w.is_empty())
+            .collect();
+        allowed.insert(name.to_string(), list);
+    }
+    let mut files = Vec::new();
+    rs_files(&Path::new(ROOT).join("src/engine"), &mut files, 0);
+    let mut wrong = Vec::new();
+    for m in &modules {
+        let Some(ok) = allowed.get(m) else {
+            wrong.push(format!("engine/{m}: no row in src/README.md"));
+            continue;
+        };
+        let mut used = BTreeSet::new();
+        for (p, depth) in &files {
+            let rel = p.strip_prefix(Path::new(ROOT).join("src/engine")).unwrap();
+            let first = rel.iter().next().unwrap().to_string_lossy();
+            if first.trim_end_matches(".rs") == m {
+                used.extend(imports(p, *depth, &modules));
+            }
+        }
+        used.remove(m);
+        used.remove("error");
+        let extra: Vec<&String> = used.iter().filter(|u| !ok.contains(*u)).collect();
+        let stale: Vec<&String> = ok.iter().filter(|a| !used.contains(*a)).collect();
+        if !extra.is_empty() || !stale.is_empty() {
+            wrong.push(format!(
+                "engine/{m}: imports {used:?}; the row says {ok:?} (missing {extra:?}, not used {stale:?})"
+            ));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "src/README.md drifted:\n{}",
+        wrong.join("\n")
+    );
+}
