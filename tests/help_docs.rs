@@ -32,3 +32,27 @@ fn every_registered_name_has_help() {
     missing.dedup();
     assert!(missing.is_empty(), "no :help entry for {missing:?}");
 }
+
+/// Each choice is defined once (engine::choice): its `:help` entry lists exactly those names.
+#[test]
+fn help_lists_every_choice_as_the_engine_defines_it() {
+    use swimlab::engine::choice::{names, Named};
+    use swimlab::engine::{Backend, Coefficients, Mobility, Model};
+    fn check<T: Named>(property: &str) {
+        let d = DOCS.iter().find(|d| d.name == property).unwrap();
+        let shown = names::<T>()
+            .iter()
+            .map(|n| format!("\"{n}\""))
+            .collect::<Vec<_>>()
+            .join(" | ");
+        assert!(
+            d.signature.contains(&format!("s.{property} = {shown}")),
+            ":help {property} should list {shown}: {}",
+            d.signature
+        );
+    }
+    check::<Model>("model");
+    check::<Mobility>("mobility");
+    check::<Backend>("backend");
+    check::<Coefficients>("coefficients");
+}

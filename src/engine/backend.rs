@@ -8,7 +8,8 @@
 //! extrapolates cost = overhead + c·N² from the two largest sizes (none if the GPU's cost per
 //! pair is not lower, as with a CPU-emulated adapter slower than the CPU kernel).
 
-use super::error::{invalid, Result};
+use super::choice::{self, Choice, Named};
+use super::error::Result;
 use super::gpu::rk_stages::Tableau;
 use super::integrators::IntegratorSpec;
 use super::model::Model;
@@ -30,26 +31,36 @@ pub enum Backend {
     Auto,
 }
 
+impl Named for Backend {
+    const KIND: &'static str = "backend";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: Backend::Cpu,
+            name: "cpu",
+            about: "default",
+        },
+        Choice {
+            value: Backend::Gpu,
+            name: "gpu",
+            about: "always the GPU",
+        },
+        Choice {
+            value: Backend::Auto,
+            name: "auto",
+            about: "the GPU when present and faster for the scene\'s size",
+        },
+    ];
+}
+
 impl Backend {
     /// Parse a user-facing name.
     pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "cpu" => Ok(Backend::Cpu),
-            "gpu" => Ok(Backend::Gpu),
-            "auto" => Ok(Backend::Auto),
-            other => Err(invalid!(
-                "unknown backend \"{other}\"; use \"cpu\" (default), \"gpu\" or \"auto\" (the GPU when present and faster for the scene's size)"
-            )),
-        }
+        choice::parse(name)
     }
 
     /// The user-facing name.
     pub fn name(self) -> &'static str {
-        match self {
-            Backend::Cpu => "cpu",
-            Backend::Gpu => "gpu",
-            Backend::Auto => "auto",
-        }
+        choice::name(self)
     }
 }
 

@@ -68,6 +68,16 @@ pub enum EngineError {
     /// A parameter or argument is out of its domain.
     #[error("{0}")]
     Invalid(String),
+    /// A name that is not one of a choice's values (see [`super::choice`]).
+    #[error("unknown {kind} \"{given}\"; use {}", valid.iter().map(|(n, a)| format!("\"{n}\" ({a})")).collect::<Vec<_>>().join(", "))]
+    UnknownChoice {
+        /// What was chosen ("model").
+        kind: &'static str,
+        /// The name given.
+        given: String,
+        /// The valid names, each with a few words.
+        valid: Vec<(&'static str, &'static str)>,
+    },
     /// Something this scene's settings do not allow; any of `fixes` would.
     #[error("{problem}; use {}", fixes_in_words(fixes))]
     Unsupported {

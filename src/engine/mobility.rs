@@ -6,7 +6,8 @@
 //! apart lets the microscopic model drop the self terms from dR_H/dt, where they cancel exactly
 //! (the hydrodynamic centre is the centre of friction), instead of cancelling them in floating point.
 
-use super::error::{invalid, Result};
+use super::choice::{self, Choice, Named};
+use super::error::Result;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -22,24 +23,31 @@ pub enum Mobility {
     Oseen,
 }
 
+impl Named for Mobility {
+    const KIND: &'static str = "mobility";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: Mobility::Rpy,
+            name: "rpy",
+            about: "Rotne-Prager-Yamakawa, default",
+        },
+        Choice {
+            value: Mobility::Oseen,
+            name: "oseen",
+            about: "point forces",
+        },
+    ];
+}
+
 impl Mobility {
     /// Parse a user-facing name.
     pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "rpy" => Ok(Mobility::Rpy),
-            "oseen" => Ok(Mobility::Oseen),
-            other => Err(invalid!(
-                "unknown mobility \"{other}\"; use \"rpy\" (Rotne-Prager-Yamakawa, default) or \"oseen\""
-            )),
-        }
+        choice::parse(name)
     }
 
     /// The user-facing name.
     pub fn name(self) -> &'static str {
-        match self {
-            Mobility::Rpy => "rpy",
-            Mobility::Oseen => "oseen",
-        }
+        choice::name(self)
     }
 
     /// The pair block as H_αβ = c_I I + c_rr r̂r̂ for spheres of radii `ai`, `aj` a distance `d`

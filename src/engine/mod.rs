@@ -7,6 +7,7 @@
 pub mod averaged;
 pub mod backend;
 pub mod build;
+pub mod choice;
 pub mod contacts;
 pub mod error;
 pub mod files;

@@ -8,7 +8,8 @@
 //! - `y[6σ+3..6σ+6]`: the microscopic model's dumbbell vector b = X₂ − X₁ (m); the averaged model's
 //!   unit orientation N, and so the rigid-stroke model's (whose length is L(t)).
 
-use super::error::{invalid, Result};
+use super::choice::{self, Choice, Named};
+use super::error::Result;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -28,26 +29,36 @@ pub enum Model {
     Rigid,
 }
 
+impl Named for Model {
+    const KIND: &'static str = "model";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: Model::Micro,
+            name: "micro",
+            about: "spheres and springs, default",
+        },
+        Choice {
+            value: Model::Rigid,
+            name: "rigid",
+            about: "spheres, lengths prescribed",
+        },
+        Choice {
+            value: Model::Averaged,
+            name: "averaged",
+            about: "stroke-averaged R_H and N",
+        },
+    ];
+}
+
 impl Model {
     /// Parse a user-facing name.
     pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "micro" => Ok(Model::Micro),
-            "averaged" => Ok(Model::Averaged),
-            "rigid" => Ok(Model::Rigid),
-            other => Err(invalid!(
-                "unknown model \"{other}\"; use \"micro\" (spheres and springs, default), \"rigid\" (spheres, lengths prescribed) or \"averaged\" (stroke-averaged R_H and N)"
-            )),
-        }
+        choice::parse(name)
     }
 
     /// The user-facing name.
     pub fn name(self) -> &'static str {
-        match self {
-            Model::Micro => "micro",
-            Model::Averaged => "averaged",
-            Model::Rigid => "rigid",
-        }
+        choice::name(self)
     }
 }
 
@@ -62,24 +73,31 @@ pub enum Coefficients {
     LeadingOrder,
 }
 
+impl Named for Coefficients {
+    const KIND: &'static str = "coefficient set";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: Coefficients::Paper,
+            name: "paper",
+            about: "as published, default",
+        },
+        Choice {
+            value: Coefficients::LeadingOrder,
+            name: "leading_order",
+            about: "the leading-order ones",
+        },
+    ];
+}
+
 impl Coefficients {
     /// Parse a user-facing name.
     pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "paper" => Ok(Coefficients::Paper),
-            "leading_order" => Ok(Coefficients::LeadingOrder),
-            other => Err(invalid!(
-                "unknown coefficient set \"{other}\"; use \"paper\" (as published, default) or \"leading_order\""
-            )),
-        }
+        choice::parse(name)
     }
 
     /// The user-facing name.
     pub fn name(self) -> &'static str {
-        match self {
-            Coefficients::Paper => "paper",
-            Coefficients::LeadingOrder => "leading_order",
-        }
+        choice::name(self)
     }
 }
 

@@ -41,6 +41,20 @@ fn fixes_in_script(fixes: &[Setting]) -> String {
 /// An engine error as a script user reads it: the engine's message, its fixes as script lines.
 pub fn engine_message(e: &EngineError) -> String {
     match e {
+        EngineError::UnknownChoice { kind, given, valid } => {
+            let names: Vec<&str> = valid.iter().map(|(n, _)| *n).collect();
+            let hint = suggest(given, &names)
+                .map(|s| format!(" did you mean \"{s}\"?"))
+                .unwrap_or_default();
+            format!(
+                "unknown {kind} \"{given}\";{hint} valid: {}",
+                valid
+                    .iter()
+                    .map(|(n, a)| format!("\"{n}\" ({a})"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        }
         EngineError::Unsupported { problem, fixes } => {
             format!("{problem}; use {}", fixes_in_script(fixes))
         }

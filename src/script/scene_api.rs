@@ -272,8 +272,7 @@ pub fn register(engine: &mut Engine) {
             "model",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let name = string_arg("model", &v)?;
-                let m = Model::parse(&name)
-                    .map_err(|_| unknown_choice("model", &name, &["micro", "rigid", "averaged"]))?;
+                let m = lift(Model::parse(&name))?;
                 s.borrow_mut().set_model(m);
                 Ok(())
             },
@@ -283,8 +282,7 @@ pub fn register(engine: &mut Engine) {
             "mobility",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let name = string_arg("mobility", &v)?;
-                let m = Mobility::parse(&name)
-                    .map_err(|_| unknown_choice("mobility", &name, &["rpy", "oseen"]))?;
+                let m = lift(Mobility::parse(&name))?;
                 s.borrow_mut().set_mobility(m);
                 Ok(())
             },
@@ -294,8 +292,7 @@ pub fn register(engine: &mut Engine) {
             "backend",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let name = string_arg("backend", &v)?;
-                let b = Backend::parse(&name)
-                    .map_err(|_| unknown_choice("backend", &name, &["cpu", "gpu", "auto"]))?;
+                let b = lift(Backend::parse(&name))?;
                 if b == Backend::Gpu {
                     crate::engine::gpu::device().map_err(|e| {
                         script_error(format!(
@@ -315,9 +312,7 @@ pub fn register(engine: &mut Engine) {
             "coefficients",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let name = string_arg("coefficients", &v)?;
-                let c = Coefficients::parse(&name).map_err(|_| {
-                    unknown_choice("coefficient set", &name, &["paper", "leading_order"])
-                })?;
+                let c = lift(Coefficients::parse(&name))?;
                 s.borrow_mut().set_coefficients(c);
                 Ok(())
             },

@@ -1,0 +1,51 @@
+//! One definition per named choice (model, mobility, backend, coefficient set): each enum lists
+//! its values once, with the user-facing name and a few words on each; parsing, display, the
+//! engine's "unknown ..." error, the script layer's "did you mean" and the `:help` check all read
+//! that one table.
+
+use super::error::{EngineError, Result};
+
+/// One value of a choice: the value, its name, and what it means.
+#[derive(Debug, Clone, Copy)]
+pub struct Choice<T: 'static> {
+    /// The value.
+    pub value: T,
+    /// Its user-facing name.
+    pub name: &'static str,
+    /// A few words on it ("spheres and springs, default").
+    pub about: &'static str,
+}
+
+/// A set of named values.
+pub trait Named: Copy + PartialEq + 'static {
+    /// What the choice is called in messages ("model").
+    const KIND: &'static str;
+    /// Every value, in the order messages list them.
+    const CHOICES: &'static [Choice<Self>];
+}
+
+/// The name of `value`.
+pub fn name<T: Named>(value: T) -> &'static str {
+    T::CHOICES
+        .iter()
+        .find(|c| c.value == value)
+        .map_or("?", |c| c.name)
+}
+
+/// Every name, in order.
+pub fn names<T: Named>() -> Vec<&'static str> {
+    T::CHOICES.iter().map(|c| c.name).collect()
+}
+
+/// The value called `given`, or [`EngineError::UnknownChoice`] listing the valid ones.
+pub fn parse<T: Named>(given: &str) -> Result<T> {
+    T::CHOICES
+        .iter()
+        .find(|c| c.name == given)
+        .map(|c| c.value)
+        .ok_or_else(|| EngineError::UnknownChoice {
+            kind: T::KIND,
+            given: given.to_string(),
+            valid: T::CHOICES.iter().map(|c| (c.name, c.about)).collect(),
+        })
+}
