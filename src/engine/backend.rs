@@ -52,17 +52,7 @@ impl Named for Backend {
     ];
 }
 
-impl Backend {
-    /// Parse a user-facing name.
-    pub fn parse(name: &str) -> Result<Self> {
-        choice::parse(name)
-    }
-
-    /// The user-facing name.
-    pub fn name(self) -> &'static str {
-        choice::name(self)
-    }
-}
+choice::inherent_names!(Backend);
 
 /// The device Runge-Kutta method for an integrator, or why it has none.
 pub fn gpu_tableau(spec: &IntegratorSpec) -> std::result::Result<(f64, Tableau), String> {

@@ -49,3 +49,21 @@ pub fn parse<T: Named>(given: &str) -> Result<T> {
             valid: T::CHOICES.iter().map(|c| (c.name, c.about)).collect(),
         })
 }
+
+/// `T::parse(name)` and `t.name()` as inherent methods of a [`Named`] type, read from its table.
+macro_rules! inherent_names {
+    ($t:ty) => {
+        impl $t {
+            /// Parse a user-facing name.
+            pub fn parse(name: &str) -> $crate::engine::error::Result<Self> {
+                $crate::engine::choice::parse(name)
+            }
+
+            /// The user-facing name.
+            pub fn name(self) -> &'static str {
+                $crate::engine::choice::name(self)
+            }
+        }
+    };
+}
+pub(crate) use inherent_names;

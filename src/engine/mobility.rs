@@ -7,7 +7,6 @@
 //! (the hydrodynamic centre is the centre of friction), instead of cancelling them in floating point.
 
 use super::choice::{self, Choice, Named};
-use super::error::Result;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -39,17 +38,9 @@ impl Named for Mobility {
     ];
 }
 
+choice::inherent_names!(Mobility);
+
 impl Mobility {
-    /// Parse a user-facing name.
-    pub fn parse(name: &str) -> Result<Self> {
-        choice::parse(name)
-    }
-
-    /// The user-facing name.
-    pub fn name(self) -> &'static str {
-        choice::name(self)
-    }
-
     /// The pair block as H_αβ = c_I I + c_rr r̂r̂ for spheres of radii `ai`, `aj` a distance `d`
     /// apart: (c_I, c_rr).
     ///

@@ -9,7 +9,6 @@
 //!   unit orientation N, and so the rigid-stroke model's (whose length is L(t)).
 
 use super::choice::{self, Choice, Named};
-use super::error::Result;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -50,17 +49,7 @@ impl Named for Model {
     ];
 }
 
-impl Model {
-    /// Parse a user-facing name.
-    pub fn parse(name: &str) -> Result<Self> {
-        choice::parse(name)
-    }
-
-    /// The user-facing name.
-    pub fn name(self) -> &'static str {
-        choice::name(self)
-    }
-}
+choice::inherent_names!(Model);
 
 /// Coefficients of the averaged model's I and J terms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -89,17 +78,7 @@ impl Named for Coefficients {
     ];
 }
 
-impl Coefficients {
-    /// Parse a user-facing name.
-    pub fn parse(name: &str) -> Result<Self> {
-        choice::parse(name)
-    }
-
-    /// The user-facing name.
-    pub fn name(self) -> &'static str {
-        choice::name(self)
-    }
-}
+choice::inherent_names!(Coefficients);
 
 /// The 3-vector at `y[i..i+3]`.
 #[inline]
