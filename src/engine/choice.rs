@@ -46,8 +46,34 @@ pub fn parse<T: Named>(given: &str) -> Result<T> {
         .ok_or_else(|| EngineError::UnknownChoice {
             kind: T::KIND,
             given: given.to_string(),
+            closest: closest(given, &names::<T>()),
             valid: T::CHOICES.iter().map(|c| (c.name, c.about)).collect(),
         })
+}
+
+/// The closest of `options` to `word` by edit distance, if reasonably close (for "did you mean").
+pub fn closest<'a>(word: &str, options: &[&'a str]) -> Option<&'a str> {
+    options
+        .iter()
+        .map(|o| (edit_distance(word, o), *o))
+        .filter(|(d, o)| *d <= (o.len() / 2).max(1))
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, o)| o)
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
 }
 
 /// `T::parse(name)` and `t.name()` as inherent methods of a [`Named`] type, read from its table.

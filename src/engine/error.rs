@@ -1,7 +1,5 @@
 //! Errors the engine reports. Each names the problem and, where there is one, the fix.
 
-use thiserror::Error;
-
 /// A scene setting that an error names as its fix, in engine terms. The engine's messages show
 /// it in words ("the cpu backend"); the script layer shows it as the script line that makes it
 /// (`s.backend = "cpu"`), so neither layer's syntax leaks into the other.
@@ -53,33 +51,24 @@ impl std::fmt::Display for Setting {
     }
 }
 
-/// "use A or B" in engine words.
-fn fixes_in_words(fixes: &[Setting]) -> String {
-    fixes
-        .iter()
-        .map(Setting::to_string)
-        .collect::<Vec<_>>()
-        .join(" or ")
-}
-
-/// Everything that can go wrong in the engine.
-#[derive(Debug, Clone, PartialEq, Error)]
+/// Everything that can go wrong in the engine. Its display speaks engine words; a front end
+/// that has its own syntax for settings renders the same message with [`EngineError::message_with`].
+#[derive(Debug, Clone, PartialEq)]
 pub enum EngineError {
     /// A parameter or argument is out of its domain.
-    #[error("{0}")]
     Invalid(String),
     /// A name that is not one of a choice's values (see [`super::choice`]).
-    #[error("unknown {kind} \"{given}\"; use {}", valid.iter().map(|(n, a)| format!("\"{n}\" ({a})")).collect::<Vec<_>>().join(", "))]
     UnknownChoice {
         /// What was chosen ("model").
         kind: &'static str,
         /// The name given.
         given: String,
+        /// The closest valid name, if one is close ("did you mean").
+        closest: Option<&'static str>,
         /// The valid names, each with a few words.
         valid: Vec<(&'static str, &'static str)>,
     },
     /// Something this scene's settings do not allow; any of `fixes` would.
-    #[error("{problem}; use {}", fixes_in_words(fixes))]
     Unsupported {
         /// What cannot be done, and why.
         problem: String,
@@ -87,10 +76,6 @@ pub enum EngineError {
         fixes: Vec<Setting>,
     },
     /// A step produced a bad state (NaN/inf or overlapping spheres); the scene kept the last good one.
-    #[error(
-        "the run stopped at t = {time:.6e} s: {cause}; the scene keeps the last good state (t = {last_good:.6e} s). Likely fix: {hint}{}",
-        if fixes.is_empty() { String::new() } else { format!("; or use {}", fixes_in_words(fixes)) }
-    )]
     StepFailed {
         /// Time at which the bad state was produced.
         time: f64,
@@ -106,12 +91,67 @@ pub enum EngineError {
         fixes: Vec<Setting>,
     },
     /// The run was interrupted from outside (Ctrl-C) at a clean step boundary.
-    #[error("run interrupted at t = {time:.6e} s; the scene keeps the state at that time")]
     Interrupted {
         /// Time at which the run stopped.
         time: f64,
     },
 }
+
+impl EngineError {
+    /// The message, with each fix shown by `show` (the display uses [`Setting`]'s words; the
+    /// script layer shows the script line that makes the setting).
+    pub fn message_with(&self, show: &dyn Fn(&Setting) -> String) -> String {
+        let fixes = |fixes: &[Setting]| fixes.iter().map(show).collect::<Vec<_>>().join(" or ");
+        match self {
+            EngineError::Invalid(msg) => msg.clone(),
+            EngineError::UnknownChoice {
+                kind,
+                given,
+                closest,
+                valid,
+            } => format!(
+                "unknown {kind} \"{given}\";{} valid: {}",
+                closest
+                    .map(|c| format!(" did you mean \"{c}\"?"))
+                    .unwrap_or_default(),
+                valid
+                    .iter()
+                    .map(|(n, a)| format!("\"{n}\" ({a})"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            EngineError::Unsupported { problem, fixes: f } => {
+                format!("{problem}; use {}", fixes(f))
+            }
+            EngineError::StepFailed {
+                time,
+                last_good,
+                cause,
+                hint,
+                fixes: f,
+                ..
+            } => format!(
+                "the run stopped at t = {time:.6e} s: {cause}; the scene keeps the last good state (t = {last_good:.6e} s). Likely fix: {hint}{}",
+                if f.is_empty() {
+                    String::new()
+                } else {
+                    format!("; or use {}", fixes(f))
+                }
+            ),
+            EngineError::Interrupted { time } => format!(
+                "run interrupted at t = {time:.6e} s; the scene keeps the state at that time"
+            ),
+        }
+    }
+}
+
+impl std::fmt::Display for EngineError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message_with(&Setting::to_string))
+    }
+}
+
+impl std::error::Error for EngineError {}
 
 /// An [`EngineError::Unsupported`].
 pub fn unsupported(problem: impl Into<String>, fixes: &[Setting]) -> EngineError {

@@ -110,9 +110,4 @@ impl LineStream {
             .write_all(buf.as_bytes())
             .map_err(|e| write_error(&self.path, e))
     }
-
-    /// Where the lines go.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
 }

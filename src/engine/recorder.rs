@@ -59,6 +59,21 @@ pub const MAX_ROWS_PER_RUN: f64 = 1e7;
 /// this, consecutive due times can no longer be told apart in f64.
 pub const MIN_RELATIVE_INTERVAL: f64 = 1e-12;
 
+const RECORD_LESS_OFTEN: &str = "record less often (a larger every_periods(n) or every_seconds(t))";
+
+/// Refuse an interval `dt` (s) that f64 cannot tell apart at times of size `scale` (s): below
+/// [`MIN_RELATIVE_INTERVAL`] of them, consecutive due times or steps round to the same time.
+/// `what` names the interval in the message, `fix` says what to change.
+pub fn require_resolvable(what: &str, dt: f64, scale: f64, fix: &str) -> Result<()> {
+    let floor = MIN_RELATIVE_INTERVAL * scale.abs();
+    if dt > 0.0 && dt >= floor {
+        return Ok(());
+    }
+    Err(invalid!(
+        "{what} ({dt:e} s) cannot be resolved at t = {scale:e} s, so it cannot advance the time: f64 tells times apart only down to ~{floor:e} s there; {fix}"
+    ))
+}
+
 /// A recorder: observables, a trigger, and the rows taken so far.
 #[derive(Debug)]
 pub struct Recorder {
@@ -101,14 +116,12 @@ impl Recorder {
             _ => None,
         };
         if let Some(dt) = interval {
-            let floor = MIN_RELATIVE_INTERVAL * scene.time().abs();
-            if !(dt > floor && dt > 0.0) {
-                return Err(invalid!(
-                    "a recorder {} (an interval of {dt:e} s) cannot be resolved at t = {:e} s: f64 tells times apart only down to ~{floor:e} s there; record less often",
-                    trigger.describe(),
-                    scene.time()
-                ));
-            }
+            require_resolvable(
+                &format!("a recorder {}", trigger.describe()),
+                dt,
+                scene.time(),
+                RECORD_LESS_OFTEN,
+            )?;
         }
         let mut r = Recorder {
             observables,
@@ -202,14 +215,16 @@ impl Recorder {
             return Ok(());
         };
         let scale = t0.abs().max(t_end.abs()).max(self.start.abs());
-        if dt < MIN_RELATIVE_INTERVAL * scale {
-            return Err(invalid!(
-                "the recorder of {} ({}, an interval of {dt:e} s) cannot be resolved at t = {scale:e} s: f64 tells times apart only down to ~{:e} s there; record less often (a larger every_periods(n) or every_seconds(t))",
+        require_resolvable(
+            &format!(
+                "the recorder of {} ({})",
                 self.columns()[1..].join(", "),
-                self.trigger.describe(),
-                MIN_RELATIVE_INTERVAL * scale
-            ));
-        }
+                self.trigger.describe()
+            ),
+            dt,
+            scale,
+            RECORD_LESS_OFTEN,
+        )?;
         let rows = (t_end - t0) / dt;
         if rows > MAX_ROWS_PER_RUN {
             let values = rows * self.columns().len() as f64;
@@ -228,68 +243,51 @@ impl Recorder {
         for o in &self.observables {
             row.extend(o.measure(scene, interrupted)?);
         }
-        let line = self.stream.as_ref().map(|_| csv_line(&row));
+        // The row is kept in memory even if its line cannot be written.
+        let streamed = match &mut self.stream {
+            Some(s) => s.append(&csv_line(row.iter().map(f64_field))),
+            None => Ok(()),
+        };
         self.rows.push(row);
-        match (&mut self.stream, line) {
-            (Some(s), Some(line)) => s.append(&line),
-            _ => Ok(()),
-        }
+        streamed
     }
 
     /// Stream rows to `path` as CSV from now on: the file is created with the header and every
     /// row taken so far, then each new row is appended (one whole line, unbuffered) as it is
     /// taken. A kill loses no row already recorded; a later `stream_csv` moves the stream.
     pub fn stream_csv(&mut self, path: &std::path::Path) -> Result<()> {
-        let mut lines = vec![csv_line(&self.header())];
-        lines.extend(self.rows.iter().map(|r| csv_line(r)));
+        let mut lines = vec![csv_line(self.header())];
+        lines.extend(self.rows.iter().map(|r| csv_line(r.iter().map(f64_field))));
         self.stream = Some(LineStream::create(path, &lines)?);
         Ok(())
-    }
-
-    /// The file rows are streamed to, if any.
-    pub fn stream_path(&self) -> Option<&std::path::Path> {
-        self.stream.as_ref().map(LineStream::path)
     }
 
     /// Write the rows as CSV with a header carrying names and units (to a temporary file renamed
     /// over `path`: a crash keeps the old file whole).
     pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
         write_atomically(path, |w| {
-            writeln!(w, "{}", csv_line(&self.header()))?;
+            let mut csv = csv::Writer::from_writer(w);
+            csv.write_record(self.header())?;
             for row in &self.rows {
-                writeln!(w, "{}", csv_line(row))?;
+                csv.write_record(row.iter().map(f64_field))?;
             }
-            Ok(())
+            csv.flush()
         })
     }
 }
 
-/// One CSV line (without the newline): numbers in shortest round-trip form, text quoted where
-/// the csv crate would.
-fn csv_line<T: CsvField>(fields: &[T]) -> String {
-    fields
-        .iter()
-        .map(CsvField::field)
-        .collect::<Vec<_>>()
-        .join(",")
+/// A number as CSV writes it here: the shortest text that reads back to the same f64.
+fn f64_field(v: &f64) -> String {
+    format!("{v:?}")
 }
 
-trait CsvField {
-    fn field(&self) -> String;
-}
-
-impl CsvField for f64 {
-    fn field(&self) -> String {
-        format!("{self:?}")
-    }
-}
-
-impl CsvField for String {
-    fn field(&self) -> String {
-        if self.contains([',', '"', '\n', '\r']) {
-            format!("\"{}\"", self.replace('"', "\"\""))
-        } else {
-            self.clone()
-        }
-    }
+/// One CSV line (without its newline), quoted as the csv crate quotes, for the row stream.
+fn csv_line(fields: impl IntoIterator<Item = String>) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    // Writing to memory cannot fail.
+    let _ = w.write_record(fields);
+    let bytes = w.into_inner().unwrap_or_default();
+    String::from_utf8_lossy(&bytes)
+        .trim_end_matches('\n')
+        .to_string()
 }

@@ -322,14 +322,13 @@ impl Figure {
     /// value gets a unit-wide range).
     fn range(&self, x_axis: bool) -> (f64, f64) {
         let log = if x_axis { self.log_x } else { self.log_y };
-        let vals = self
-            .series
-            .iter()
-            .flat_map(|s| if x_axis { &s.x } else { &s.y })
-            .map(|v| if log { v.log10() } else { *v });
-        let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(v), b.max(v))
-        });
+        // log10 is monotonic: the range of the logs is the log of the range.
+        let (lo, hi) = self.data_range(x_axis);
+        let (lo, hi) = if log {
+            (lo.log10(), hi.log10())
+        } else {
+            (lo, hi)
+        };
         if hi > lo {
             let pad = 0.05 * (hi - lo);
             (lo - pad, hi + pad)

@@ -30,47 +30,9 @@ pub fn setting_in_script(s: &Setting) -> String {
     }
 }
 
-fn fixes_in_script(fixes: &[Setting]) -> String {
-    fixes
-        .iter()
-        .map(setting_in_script)
-        .collect::<Vec<_>>()
-        .join(" or ")
-}
-
 /// An engine error as a script user reads it: the engine's message, its fixes as script lines.
 pub fn engine_message(e: &EngineError) -> String {
-    match e {
-        EngineError::UnknownChoice { kind, given, valid } => {
-            let names: Vec<&str> = valid.iter().map(|(n, _)| *n).collect();
-            let hint = suggest(given, &names)
-                .map(|s| format!(" did you mean \"{s}\"?"))
-                .unwrap_or_default();
-            format!(
-                "unknown {kind} \"{given}\";{hint} valid: {}",
-                valid
-                    .iter()
-                    .map(|(n, a)| format!("\"{n}\" ({a})"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
-        }
-        EngineError::Unsupported { problem, fixes } => {
-            format!("{problem}; use {}", fixes_in_script(fixes))
-        }
-        EngineError::StepFailed {
-            time,
-            last_good,
-            cause,
-            hint,
-            fixes,
-            ..
-        } if !fixes.is_empty() => format!(
-            "the run stopped at t = {time:.6e} s: {cause}; the scene keeps the last good state (t = {last_good:.6e} s). Likely fix: {hint}; or use {}",
-            fixes_in_script(fixes)
-        ),
-        other => other.to_string(),
-    }
+    e.message_with(&setting_in_script)
 }
 
 /// Engine errors become script errors carrying the engine's message in script terms.
@@ -131,30 +93,8 @@ pub fn index(i: INT) -> ScriptResult<usize> {
         .map_err(|_| script_error(format!("swimmer index {i} is negative; indices start at 0")))
 }
 
-/// The closest of `options` to `word` by edit distance, if reasonably close (for "did you mean").
-pub fn suggest<'a>(word: &str, options: &[&'a str]) -> Option<&'a str> {
-    options
-        .iter()
-        .map(|o| (edit_distance(word, o), *o))
-        .filter(|(d, o)| *d <= (o.len() / 2).max(1))
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, o)| o)
-}
-
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
-                .min(prev[j + 1] + 1)
-                .min(cur[j] + 1);
-        }
-        prev = cur;
-    }
-    prev[b.len()]
-}
+/// The closest of `options` to `word`, if reasonably close (for "did you mean").
+pub use crate::engine::choice::closest as suggest;
 
 /// "unknown X \"w\"; did you mean \"y\"? Valid: a, b, c".
 pub fn unknown_choice(kind: &str, word: &str, options: &[&str]) -> Box<EvalAltResult> {

@@ -99,6 +99,11 @@ pub fn run_source_with(
 pub fn read_text(path: &std::path::Path, max: u64, what: &str) -> Result<String, String> {
     use std::io::Read;
     let shown = path.display();
+    let too_big = || {
+        format!(
+            "cannot read {what} {shown}: it is larger than {max} bytes, more than any {what} swimlab writes; check the path"
+        )
+    };
     let file = std::fs::File::open(path).map_err(|e| {
         format!("cannot read {what} {shown}: {e}; check the path (relative paths start in the working folder)")
     })?;
@@ -108,11 +113,9 @@ pub fn read_text(path: &std::path::Path, max: u64, what: &str) -> Result<String,
                 "cannot read {what} {shown}: it is a folder; give a file"
             ));
         }
+        // A regular file is measured before reading; a device or pipe by reading at most max + 1.
         if m.is_file() && m.len() > max {
-            return Err(format!(
-                "cannot read {what} {shown}: it is {} bytes, larger than the {max} of any {what} swimlab writes; check the path",
-                m.len()
-            ));
+            return Err(too_big());
         }
     }
     let mut bytes = Vec::new();
@@ -120,9 +123,7 @@ pub fn read_text(path: &std::path::Path, max: u64, what: &str) -> Result<String,
         .read_to_end(&mut bytes)
         .map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
     if bytes.len() as u64 > max {
-        return Err(format!(
-            "cannot read {what} {shown}: it is larger than {max} bytes, more than any {what} swimlab writes; check the path"
-        ));
+        return Err(too_big());
     }
     String::from_utf8(bytes).map_err(|e| {
         format!("cannot read {what} {shown}: it is not UTF-8 text ({e}); save it as UTF-8")

@@ -68,8 +68,8 @@ pub fn register_defaults(engine: &mut Engine) {
 struct Uses {
     /// Read as a variable or through `param("name", ...)`.
     read: bool,
-    /// Top-level declarations that do not read the name: (position, keyword).
-    shadows: Vec<Position>,
+    /// The first top-level declaration that hides the name without reading it.
+    shadow: Option<Position>,
 }
 
 /// Check the script against the `--set` names: every name read, none shadowed.
@@ -133,14 +133,14 @@ pub fn check(ast: &AST, sets: &Sets) -> Result<(), (Position, String)> {
     }
     for (k, pos, reads_itself) in declared {
         if !reads_itself {
-            uses[k].shadows.push(pos);
+            uses[k].shadow.get_or_insert(pos);
         }
     }
     for (k, u) in uses.iter().enumerate() {
         let (name, value) = (&sets[k].0, &sets[k].1);
-        if let Some(pos) = u.shadows.first() {
+        if let Some(pos) = u.shadow {
             return Err((
-                *pos,
+                pos,
                 format!(
                     "this declaration of {name} hides the value given by --set {name}={value}; to let --set choose and keep a default, write let {name} = param(\"{name}\", <default>);"
                 ),

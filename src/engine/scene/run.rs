@@ -62,12 +62,12 @@ impl Scene {
         }
         if let IntegratorSpec::Euler { dt } | IntegratorSpec::Rk4 { dt } = self.integrator() {
             let scale = self.time.abs().max(t_end.abs());
-            if dt < crate::engine::recorder::MIN_RELATIVE_INTERVAL * scale {
-                return Err(invalid!(
-                    "the step dt = {dt:e} s cannot advance the time at t = {scale:e} s (f64 resolves only ~{:e} s there); use a larger step, or a new scene from time 0",
-                    crate::engine::recorder::MIN_RELATIVE_INTERVAL * scale
-                ));
-            }
+            crate::engine::recorder::require_resolvable(
+                &format!("the step dt = {dt:e} s"),
+                dt,
+                scale,
+                "use a larger step, or a new scene from time 0",
+            )?;
             let steps = (t_end - self.time) / dt;
             if steps > MAX_FIXED_STEPS_PER_RUN {
                 return Err(invalid!(
