@@ -63,14 +63,14 @@ const RECORD_LESS_OFTEN: &str = "record less often (a larger every_periods(n) or
 
 /// Refuse an interval `dt` (s) that f64 cannot tell apart at times of size `scale` (s): below
 /// [`MIN_RELATIVE_INTERVAL`] of them, consecutive due times or steps round to the same time.
-/// `what` names the interval in the message, `fix` says what to change.
+/// `what` names the interval (with its value) in the message, `fix` says what to change.
 pub fn require_resolvable(what: &str, dt: f64, scale: f64, fix: &str) -> Result<()> {
     let floor = MIN_RELATIVE_INTERVAL * scale.abs();
     if dt > 0.0 && dt >= floor {
         return Ok(());
     }
     Err(invalid!(
-        "{what} ({dt:e} s) cannot be resolved at t = {scale:e} s, so it cannot advance the time: f64 tells times apart only down to ~{floor:e} s there; {fix}"
+        "{what} cannot be resolved at t = {scale:e} s, so it cannot advance the time: f64 tells times apart only down to ~{floor:e} s there; {fix}"
     ))
 }
 
@@ -117,7 +117,10 @@ impl Recorder {
         };
         if let Some(dt) = interval {
             require_resolvable(
-                &format!("a recorder {}", trigger.describe()),
+                &format!(
+                    "a recorder {} (an interval of {dt:e} s)",
+                    trigger.describe()
+                ),
                 dt,
                 scene.time(),
                 RECORD_LESS_OFTEN,
@@ -217,7 +220,7 @@ impl Recorder {
         let scale = t0.abs().max(t_end.abs()).max(self.start.abs());
         require_resolvable(
             &format!(
-                "the recorder of {} ({})",
+                "the recorder of {} ({}, an interval of {dt:e} s)",
                 self.columns()[1..].join(", "),
                 self.trigger.describe()
             ),
