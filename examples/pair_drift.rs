@@ -2,8 +2,7 @@
 //! φ² − φ¹ = π/2), per-period collective drift with several integrators.
 use nalgebra::Vector3;
 use std::f64::consts::FRAC_PI_2;
-use swimlab::engine::scene::never;
-use swimlab::engine::{Dumbbell, IntegratorSpec, Scene};
+use swimlab::engine::{Dumbbell, IntegratorSpec, Scene, Simulation};
 
 fn pair(spec: Option<IntegratorSpec>) -> Scene {
     let ell = 5e-6;
@@ -30,13 +29,13 @@ fn pair(spec: Option<IntegratorSpec>) -> Scene {
 }
 
 fn drift(spec: Option<IntegratorSpec>, periods: f64) -> (f64, f64, u64, f64) {
-    let mut s = pair(spec);
+    let mut s = Simulation::new(pair(spec));
     let ell = 5e-6;
-    s.run_periods(1.0, &never).unwrap();
+    s.run_periods(1.0).unwrap();
     let m0 = (s.displacement(0).unwrap().x + s.displacement(1).unwrap().x) / 2.0;
     let start = std::time::Instant::now();
     let e0 = s.stats().rhs_evals;
-    s.run_periods(periods, &never).unwrap();
+    s.run_periods(periods).unwrap();
     let el = start.elapsed().as_secs_f64();
     let m1 = (s.displacement(0).unwrap().x + s.displacement(1).unwrap().x) / 2.0;
     let sep = s.center(1).unwrap().x - s.center(0).unwrap().x;

@@ -1,6 +1,7 @@
 //! src/README.md's table is the map a newcomer reads first: every engine module has a row, and
 //! its "may import" column lists every other engine module the file (with its child modules)
-//! uses. `error` is open to all. Arrows that drift from the code fail here.
+//! uses. `error` is open to all. Arrows that drift from the code fail here, and so does an import
+//! circle between engine modules (each module must be readable with only those below it).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -78,9 +79,32 @@ fn rs_files(dir: &Path, out: &mut Vec<(std::path::PathBuf, usize)>, depth: usize
     }
 }
 
+/// What each top-level engine module (with its children) imports of the others, `error` aside.
+fn import_graph() -> BTreeMap<String, BTreeSet<String>> {
+    let modules = engine_modules();
+    let mut files = Vec::new();
+    rs_files(&Path::new(ROOT).join("src/engine"), &mut files, 0);
+    let mut graph = BTreeMap::new();
+    for m in &modules {
+        let mut used = BTreeSet::new();
+        for (p, depth) in &files {
+            let rel = p.strip_prefix(Path::new(ROOT).join("src/engine")).unwrap();
+            let first = rel.iter().next().unwrap().to_string_lossy();
+            if first.trim_end_matches(".rs") == m {
+                used.extend(imports(p, *depth, &modules));
+            }
+        }
+        used.remove(m);
+        used.remove("error");
+        graph.insert(m.clone(), used);
+    }
+    graph
+}
+
 #[test]
 fn the_may_import_column_of_src_readme_is_the_truth() {
     let modules = engine_modules();
+    let graph = import_graph();
     let readme = std::fs::read_to_string(Path::new(ROOT).join("src/README.md")).unwrap();
     let mut allowed: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for line in readme.lines() {
@@ -103,24 +127,13 @@ fn the_may_import_column_of_src_readme_is_the_truth() {
             .collect();
         allowed.insert(name.to_string(), list);
     }
-    let mut files = Vec::new();
-    rs_files(&Path::new(ROOT).join("src/engine"), &mut files, 0);
     let mut wrong = Vec::new();
     for m in &modules {
         let Some(ok) = allowed.get(m) else {
             wrong.push(format!("engine/{m}: no row in src/README.md"));
             continue;
         };
-        let mut used = BTreeSet::new();
-        for (p, depth) in &files {
-            let rel = p.strip_prefix(Path::new(ROOT).join("src/engine")).unwrap();
-            let first = rel.iter().next().unwrap().to_string_lossy();
-            if first.trim_end_matches(".rs") == m {
-                used.extend(imports(p, *depth, &modules));
-            }
-        }
-        used.remove(m);
-        used.remove("error");
+        let used = &graph[m];
         let extra: Vec<&String> = used.iter().filter(|u| !ok.contains(*u)).collect();
         let stale: Vec<&String> = ok.iter().filter(|a| !used.contains(*a)).collect();
         if !extra.is_empty() || !stale.is_empty() {
@@ -134,4 +147,39 @@ fn the_may_import_column_of_src_readme_is_the_truth() {
         "src/README.md drifted:\n{}",
         wrong.join("\n")
     );
+}
+
+#[test]
+fn the_engine_has_no_import_circle() {
+    let graph = import_graph();
+    // Depth-first search; a module met again while it is still on the path closes a circle.
+    fn visit<'a>(
+        m: &'a str,
+        graph: &'a BTreeMap<String, BTreeSet<String>>,
+        path: &mut Vec<&'a str>,
+        done: &mut BTreeSet<&'a str>,
+    ) -> Option<Vec<String>> {
+        if let Some(k) = path.iter().position(|p| *p == m) {
+            let mut circle: Vec<String> = path[k..].iter().map(|s| s.to_string()).collect();
+            circle.push(m.to_string());
+            return Some(circle);
+        }
+        if !done.insert(m) {
+            return None;
+        }
+        path.push(m);
+        for next in &graph[m] {
+            if let Some(c) = visit(next, graph, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        None
+    }
+    let mut done = BTreeSet::new();
+    for m in graph.keys() {
+        if let Some(circle) = visit(m, &graph, &mut Vec::new(), &mut done) {
+            panic!("engine import circle: {}", circle.join(" → "));
+        }
+    }
 }

@@ -8,8 +8,7 @@ use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::FRAC_PI_2;
 use swimlab::engine::averaged::{AveragedSystem, Shortcuts};
 use swimlab::engine::integrators::OdeSystem;
-use swimlab::engine::scene::never;
-use swimlab::engine::{Coefficients, Dumbbell, IntegratorSpec, Model, Scene};
+use swimlab::engine::{Coefficients, Dumbbell, IntegratorSpec, Model, Scene, Simulation};
 
 /// Right-hand side of a scene's averaged system with the given shortcuts.
 fn rates(s: &Scene, set: Coefficients, shortcuts: Shortcuts) -> Vec<f64> {
@@ -248,7 +247,8 @@ fn orientation_stays_a_unit_vector_over_a_million_periods() {
         let mut s = mixed_scene();
         s.set_model(Model::Averaged);
         s.set_integrator(spec);
-        s.run_periods(1e6, &never).unwrap();
+        let mut s = Simulation::new(s);
+        s.run_periods(1e6).unwrap();
         for i in 0..3 {
             let n = s.raw_state().0[6 * i + 3..6 * i + 6]
                 .iter()
@@ -305,13 +305,13 @@ fn far_field_microscopic_drift_matches_the_averaged_model() {
 
 #[test]
 fn switching_models_converts_the_state() {
-    let mut s = mirror_inwards(10.0, true);
-    s.run_periods(1.3, &never).unwrap();
+    let mut s = Simulation::new(mirror_inwards(10.0, true));
+    s.run_periods(1.3).unwrap();
     let (c, n) = (s.center(1).unwrap(), s.dir(1).unwrap());
-    s.set_model(Model::Averaged);
+    s.scene_mut().set_model(Model::Averaged);
     assert_eq!(s.center(1).unwrap(), c);
     assert!((s.dir(1).unwrap() - n).norm() < 1e-15);
-    s.set_model(Model::Micro);
+    s.scene_mut().set_model(Model::Micro);
     let len = s.length(1).unwrap();
     assert!((len - s.swimmer(1).unwrap().rest_length(s.time())).abs() < 1e-15 * len);
     assert_eq!(s.center(1).unwrap(), c);

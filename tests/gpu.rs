@@ -10,8 +10,7 @@ use common::{aligned_pair, mirror_inwards, ELL};
 use nalgebra::Vector3;
 use swimlab::engine::build::{random_suspension, Orientations, Phases};
 use swimlab::engine::error::Setting;
-use swimlab::engine::scene::never;
-use swimlab::engine::{Backend, Dumbbell, EngineError, IntegratorSpec, Model, Scene};
+use swimlab::engine::{Backend, Dumbbell, EngineError, IntegratorSpec, Model, Scene, Simulation};
 
 fn gpu_present(test: &str) -> bool {
     match swimlab::engine::gpu::device() {
@@ -35,6 +34,12 @@ fn twins(s: &Scene) -> (Scene, Scene) {
     (c, g)
 }
 
+/// [`twins`], ready to run.
+fn sim_twins(s: &Scene) -> (Simulation, Simulation) {
+    let (c, g) = twins(s);
+    (Simulation::new(c), Simulation::new(g))
+}
+
 /// max |Δ_gpu − Δ_cpu| / max |Δ_cpu| over the components of each block (0: centres, 1: b or N),
 /// where Δ is the change of the state over the run.
 fn block_mismatch(y0: &[f64], cpu: &[f64], gpu: &[f64]) -> [f64; 2] {
@@ -51,10 +56,11 @@ fn block_mismatch(y0: &[f64], cpu: &[f64], gpu: &[f64]) -> [f64; 2] {
 }
 
 fn one_step_mismatch(s: &Scene, dt: f64) -> [f64; 2] {
-    let (mut c, mut g) = twins(s);
+    let (mut c, mut g) = sim_twins(s);
     for x in [&mut c, &mut g] {
-        x.set_integrator(Some(IntegratorSpec::rk4(dt).unwrap()));
-        x.run(dt, &never).unwrap();
+        x.scene_mut()
+            .set_integrator(Some(IntegratorSpec::rk4(dt).unwrap()));
+        x.run(dt).unwrap();
     }
     assert_eq!(c.time(), g.time());
     block_mismatch(s.raw_state().0, c.raw_state().0, g.raw_state().0)
@@ -175,10 +181,11 @@ fn random_suspension_of_1000_swimmers_agrees() {
     }
     let s = suspension(Model::Micro, 0.01);
     let dt = s.default_micro_step();
-    let (mut c, mut g) = twins(&s);
+    let (mut c, mut g) = sim_twins(&s);
     for x in [&mut c, &mut g] {
-        x.set_integrator(Some(IntegratorSpec::rk4(dt).unwrap()));
-        x.run(3.0 * dt, &never).unwrap();
+        x.scene_mut()
+            .set_integrator(Some(IntegratorSpec::rk4(dt).unwrap()));
+        x.run(3.0 * dt).unwrap();
     }
     let m = block_mismatch(s.raw_state().0, c.raw_state().0, g.raw_state().0);
     eprintln!("1,000-swimmer micro, 3 steps: mismatch {m:?}");
@@ -187,11 +194,12 @@ fn random_suspension_of_1000_swimmers_agrees() {
     // The far-field averaged model at a lower density: its rates grow as D⁻⁵, and at the closest
     // random distances of φ = 1% a period-long step would amplify round-off chaotically.
     let s = suspension(Model::Averaged, 1e-3);
-    let (mut c, mut g) = twins(&s);
+    let (mut c, mut g) = sim_twins(&s);
     let h = s.period().unwrap();
     for x in [&mut c, &mut g] {
-        x.set_integrator(Some(IntegratorSpec::rk4(h).unwrap()));
-        x.run(3.0 * h, &never).unwrap();
+        x.scene_mut()
+            .set_integrator(Some(IntegratorSpec::rk4(h).unwrap()));
+        x.run(3.0 * h).unwrap();
     }
     let m = block_mismatch(s.raw_state().0, c.raw_state().0, g.raw_state().0);
     eprintln!("1,000-swimmer averaged, 3 steps: mismatch {m:?}");
@@ -207,11 +215,12 @@ fn unstable_step_fails_the_same_way_on_both_backends() {
     }
     let s = mirror_inwards(10.0, true);
     let dt = 6.0 / s.stiff_rate();
-    let (mut c, mut g) = twins(&s);
+    let (mut c, mut g) = sim_twins(&s);
     let mut errors = Vec::new();
     for x in [&mut c, &mut g] {
-        x.set_integrator(Some(IntegratorSpec::euler(dt).unwrap()));
-        errors.push(x.run(200.0 * dt, &never).unwrap_err().to_string());
+        x.scene_mut()
+            .set_integrator(Some(IntegratorSpec::euler(dt).unwrap()));
+        errors.push(x.run(200.0 * dt).unwrap_err().to_string());
     }
     assert_eq!(errors[0], errors[1]);
     assert_eq!(c.time(), g.time());
@@ -224,7 +233,7 @@ fn recorders_see_the_same_rows() {
         return;
     }
     use swimlab::engine::{Observable, Recorder, Trigger};
-    let (mut c, mut g) = twins(&mirror_inwards(10.0, true));
+    let (mut c, mut g) = sim_twins(&mirror_inwards(10.0, true));
     let mut ids = Vec::new();
     for x in [&mut c, &mut g] {
         let t = x.period().unwrap();
@@ -235,7 +244,7 @@ fn recorders_see_the_same_rows() {
         )
         .unwrap();
         ids.push(x.add_recorder(r));
-        x.run(2.0 * t, &never).unwrap();
+        x.run(2.0 * t).unwrap();
     }
     let (rc, rg) = (c.recorder(ids[0]).unwrap(), g.recorder(ids[1]).unwrap());
     assert!(rc.rows.len() >= 8);
@@ -254,12 +263,14 @@ fn auto_explains_its_choice() {
     }
     let mut s = mirror_inwards(10.0, true);
     s.set_backend(Backend::Auto);
-    let info = s.backend_info().unwrap();
+    let info = swimlab::engine::plan::backend_info(&s).unwrap();
     assert!(info.starts_with("cpu: auto:"), "{info}");
     s.set_model(Model::Rigid);
-    assert!(s.backend_info().unwrap().contains("rigid"));
+    assert!(swimlab::engine::plan::backend_info(&s)
+        .unwrap()
+        .contains("rigid"));
     s.set_backend(Backend::Gpu);
-    let err = s.backend_info().unwrap_err();
+    let err = swimlab::engine::plan::backend_info(&s).unwrap_err();
     let e = err.to_string();
     // Engine terms for an embedder; the script layer shows the fix as `s.backend = "cpu"`.
     assert!(e.contains("rigid") && e.contains("the cpu backend"), "{e}");

@@ -37,7 +37,7 @@ fn every_registered_name_has_help() {
 #[test]
 fn help_lists_every_choice_as_the_engine_defines_it() {
     use swimlab::engine::choice::{names, Named};
-    use swimlab::engine::{Backend, Coefficients, Mobility, Model};
+    use swimlab::engine::{Backend, Coefficients, Mobility, Model, Overlaps};
     fn check<T: Named>(property: &str) {
         let d = DOCS.iter().find(|d| d.name == property).unwrap();
         let shown = names::<T>()
@@ -55,4 +55,5 @@ fn help_lists_every_choice_as_the_engine_defines_it() {
     check::<Mobility>("mobility");
     check::<Backend>("backend");
     check::<Coefficients>("coefficients");
+    check::<Overlaps>("overlaps");
 }

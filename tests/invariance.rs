@@ -6,8 +6,7 @@ mod common;
 use common::*;
 use nalgebra::{Rotation3, Vector3};
 use std::f64::consts::FRAC_PI_2;
-use swimlab::engine::scene::never;
-use swimlab::engine::{Dumbbell, Scene};
+use swimlab::engine::{Dumbbell, Scene, Simulation};
 
 /// Two swimmers in a general 3D configuration (neither aligned nor coplanar).
 fn general_pair(shift: Vector3<f64>, rot: Rotation3<f64>, swap: bool) -> Scene {
@@ -38,14 +37,14 @@ fn displacements(s: &Scene) -> Vec<Vector3<f64>> {
 
 #[test]
 fn translating_the_scene_commutes_with_stepping() {
-    let mut a = general_pair(Vector3::zeros(), Rotation3::identity(), false);
-    let mut b = general_pair(
+    let mut a = Simulation::new(general_pair(Vector3::zeros(), Rotation3::identity(), false));
+    let mut b = Simulation::new(general_pair(
         Vector3::new(40.0, -25.0, 13.0) * ELL,
         Rotation3::identity(),
         false,
-    );
-    a.run_periods(3.0, &never).unwrap();
-    b.run_periods(3.0, &never).unwrap();
+    ));
+    a.run_periods(3.0).unwrap();
+    b.run_periods(3.0).unwrap();
     for (da, db) in displacements(&a).iter().zip(displacements(&b)) {
         // Only the rounding of absolute positions (~1e-16 × 50ℓ) in the pair distances differs:
         // 1e-12 ℓ is 1e-6 of the 3-period drift.
@@ -59,10 +58,10 @@ fn rotating_the_scene_commutes_with_stepping() {
         &nalgebra::Unit::new_normalize(Vector3::new(0.3, -1.0, 0.7)),
         1.1,
     );
-    let mut a = general_pair(Vector3::zeros(), Rotation3::identity(), false);
-    let mut b = general_pair(Vector3::zeros(), rot, false);
-    a.run_periods(3.0, &never).unwrap();
-    b.run_periods(3.0, &never).unwrap();
+    let mut a = Simulation::new(general_pair(Vector3::zeros(), Rotation3::identity(), false));
+    let mut b = Simulation::new(general_pair(Vector3::zeros(), rot, false));
+    a.run_periods(3.0).unwrap();
+    b.run_periods(3.0).unwrap();
     for (da, db) in displacements(&a).iter().zip(displacements(&b)) {
         assert!((rot * da - db).norm() < 1e-12 * ELL, "{da:?} vs {db:?}");
     }
@@ -74,10 +73,10 @@ fn rotating_the_scene_commutes_with_stepping() {
 
 #[test]
 fn relabelling_identical_swimmers_changes_nothing() {
-    let mut a = general_pair(Vector3::zeros(), Rotation3::identity(), false);
-    let mut b = general_pair(Vector3::zeros(), Rotation3::identity(), true);
-    a.run_periods(3.0, &never).unwrap();
-    b.run_periods(3.0, &never).unwrap();
+    let mut a = Simulation::new(general_pair(Vector3::zeros(), Rotation3::identity(), false));
+    let mut b = Simulation::new(general_pair(Vector3::zeros(), Rotation3::identity(), true));
+    a.run_periods(3.0).unwrap();
+    b.run_periods(3.0).unwrap();
     for i in 0..2 {
         // Only the order of floating-point sums differs.
         let diff = (a.center(i).unwrap() - b.center(1 - i).unwrap()).norm();

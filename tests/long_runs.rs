@@ -4,8 +4,7 @@
 
 mod common;
 use common::*;
-use swimlab::engine::scene::never;
-use swimlab::engine::{IntegratorSpec, Model};
+use swimlab::engine::{IntegratorSpec, Model, Simulation};
 
 fn run_long(model: Model, spec: Option<IntegratorSpec>, periods: f64) -> (f64, f64) {
     let mut s = mirror_inwards(10.0, true);
@@ -13,7 +12,8 @@ fn run_long(model: Model, spec: Option<IntegratorSpec>, periods: f64) -> (f64, f
     s.set_integrator(spec);
     let (drift, _) = drift_per_period(&mut s, 1.0); // settles, then one period
     let sep0 = s.center(1).unwrap().x - s.center(0).unwrap().x;
-    s.run_periods(periods, &never).unwrap();
+    let mut s = Simulation::new(s);
+    s.run_periods(periods).unwrap();
     let sep1 = s.center(1).unwrap().x - s.center(0).unwrap().x;
     for i in 0..2 {
         let n = s.dir(i).unwrap();

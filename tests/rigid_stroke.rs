@@ -5,8 +5,7 @@ mod common;
 use common::*;
 use nalgebra::Vector3;
 use std::f64::consts::FRAC_PI_2;
-use swimlab::engine::scene::never;
-use swimlab::engine::{Dumbbell, IntegratorSpec, Model, Scene};
+use swimlab::engine::{Dumbbell, IntegratorSpec, Model, Scene, Simulation};
 
 fn pair_with_k0(k0: f64) -> Scene {
     let mut s = Scene::new();
@@ -68,9 +67,10 @@ fn isolated_rigid_dumbbell_returns_each_period() {
         .unwrap();
         s.set_model(Model::Rigid);
         s.set_integrator(spec);
-        s.run_periods(1.0, &never).unwrap();
+        let mut s = Simulation::new(s);
+        s.run_periods(1.0).unwrap();
         let start = s.center(0).unwrap();
-        s.run_periods(3.0, &never).unwrap();
+        s.run_periods(3.0).unwrap();
         let moved = (s.center(0).unwrap() - start).norm() / ELL / 3.0;
         assert!(moved < bound, "{spec:?}: {moved:e} ell per period");
     }
@@ -98,8 +98,8 @@ fn rigid_default_integrator_meets_the_drift_accuracy_budget() {
 
 #[test]
 fn rigid_tension_matches_the_stiff_spring() {
-    let mut spring = pair_with_k0(6.4e-2);
-    spring.run_periods(1.1, &never).unwrap();
+    let mut spring = Simulation::new(pair_with_k0(6.4e-2));
+    spring.run_periods(1.1).unwrap();
     let mut rigid = spring.clone();
     rigid.set_model(Model::Rigid);
     for i in 0..2 {

@@ -7,8 +7,7 @@ mod common;
 use common::*;
 use nalgebra::Vector3;
 use std::f64::consts::PI;
-use swimlab::engine::scene::never;
-use swimlab::engine::Scene;
+use swimlab::engine::{Scene, Simulation};
 
 #[test]
 fn isolated_asymmetric_dumbbell_returns_each_period() {
@@ -19,10 +18,11 @@ fn isolated_asymmetric_dumbbell_returns_each_period() {
         Vector3::new(1.0, 2.0, -0.5),
     )
     .unwrap();
-    s.run_periods(1.0, &never).unwrap();
+    let mut s = Simulation::new(s);
+    s.run_periods(1.0).unwrap();
     let mut previous = s.center(0).unwrap();
     for _ in 0..5 {
-        s.run_periods(1.0, &never).unwrap();
+        s.run_periods(1.0).unwrap();
         let now = s.center(0).unwrap();
         // 1e-12 ℓ per period: the bound; the stroke moves R_H by ~1e-3 ℓ within a period.
         let moved = (now - previous).norm() / ELL;

@@ -7,8 +7,7 @@ use rhai::Scope;
 use swimlab::engine::averaged::AveragedSystem;
 use swimlab::engine::build::{box_side, random_suspension, Orientations, Phases};
 use swimlab::engine::integrators::OdeSystem;
-use swimlab::engine::scene::never;
-use swimlab::engine::{Coefficients, Dumbbell, Model, Observable, Scene, Steric};
+use swimlab::engine::{Coefficients, Dumbbell, Model, Observable, Scene, Simulation, Steric};
 use swimlab::script::run_source;
 
 fn suspension(model: Model, n: usize, phi: f64, d: Dumbbell, seed: u64) -> Scene {
@@ -48,7 +47,8 @@ fn all_finite(s: &Scene) -> bool {
 fn thousand_swimmer_averaged_run_stays_finite() {
     let mut s = suspension(Model::Averaged, 1000, 0.001, asymmetric(), 11);
     s.set_steric(Some(Steric::new(0.2e-6, 1e-6).unwrap()));
-    s.run_periods(3.0, &never).unwrap();
+    let mut s = Simulation::new(s);
+    s.run_periods(3.0).unwrap();
     assert!(all_finite(&s));
     let p = Observable::Polarization.evaluate(&s).unwrap()[0];
     assert!(
@@ -61,8 +61,8 @@ fn thousand_swimmer_averaged_run_stays_finite() {
 // periods with the default integrator and every guard.
 #[test]
 fn two_hundred_swimmer_micro_run_stays_finite() {
-    let mut s = suspension(Model::Micro, 200, 0.01, Dumbbell::default(), 5);
-    s.run_periods(2.0, &never).unwrap();
+    let mut s = Simulation::new(suspension(Model::Micro, 200, 0.01, Dumbbell::default(), 5));
+    s.run_periods(2.0).unwrap();
     assert!(all_finite(&s));
     let gap = Observable::MinGap.evaluate(&s).unwrap()[0];
     assert!(gap > 0.0, "min gap {gap:e}");
@@ -138,13 +138,15 @@ fn side_by_side(gap: f64) -> Scene {
 #[test]
 fn steric_repulsion_separates_close_swimmers() {
     let gap = 0.05e-6;
-    let mut plain = side_by_side(gap);
+    let plain = side_by_side(gap);
     let d0 = Observable::DistanceH(0, 1).evaluate(&plain).unwrap()[0];
-    plain.run_periods(1.0, &never).unwrap();
+    let mut plain = Simulation::new(plain);
+    plain.run_periods(1.0).unwrap();
     let d_plain = Observable::DistanceH(0, 1).evaluate(&plain).unwrap()[0];
     let mut pushed = side_by_side(gap);
     pushed.set_steric(Some(Steric::new(0.1e-6, 1e-4).unwrap()));
-    pushed.run_periods(1.0, &never).unwrap();
+    let mut pushed = Simulation::new(pushed);
+    pushed.run_periods(1.0).unwrap();
     let d_pushed = Observable::DistanceH(0, 1).evaluate(&pushed).unwrap()[0];
     assert!(
         d_pushed - d0 > 0.1 * gap && d_pushed - d0 > 100.0 * (d_plain - d0).abs(),
@@ -176,12 +178,13 @@ fn overlaps_stop_by_default_and_run_on_when_allowed() {
             .unwrap();
         s
     };
-    let mut stop = build();
-    let e = stop.run_periods(1.0, &never);
+    let mut stop = Simulation::new(build());
+    let e = stop.run_periods(1.0);
     assert!(e.is_err(), "expected a contact");
     let mut allow = build();
     allow.set_allow_overlap(true);
-    allow.run_periods(1.0, &never).unwrap();
+    let mut allow = Simulation::new(allow);
+    allow.run_periods(1.0).unwrap();
     assert!(all_finite(&allow));
 }
 

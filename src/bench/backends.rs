@@ -3,7 +3,7 @@
 //! and the crossover where the GPU starts to win on the machine at hand.
 
 use super::table::Table;
-use crate::engine::backend::{crossover, step_time};
+use crate::engine::calibrate::{crossover, step_time};
 use crate::engine::{Backend, Model};
 
 /// One measured size.

@@ -2,7 +2,7 @@
 //! model on the CPU, with the exponent of a power-law fit.
 //!
 //! Each size is a cubic lattice of Fig-1 swimmers 3ℓ apart (every pair interacts,
-//! [`crate::engine::scene::lattice_scene`]). The time per RK4 step is measured
+//! [`crate::engine::build::lattice_scene`]). The time per RK4 step is measured
 //! ([`step_time`]: repeated until a run lasts 20 ms) and multiplied by the steps a period takes:
 //! T/h with the microscopic model's default step h = 0.8/rate (the spring's stiffness sets it,
 //! whatever S), and one step per period for the averaged model (RK4 with h = T, as in the GPU
@@ -11,8 +11,8 @@
 //! minutes).
 
 use super::table::Table;
-use crate::engine::backend::step_time;
-use crate::engine::scene::lattice_scene;
+use crate::engine::build::lattice_scene;
+use crate::engine::calibrate::step_time;
 use crate::engine::{Backend, Model};
 
 /// One measured size.

@@ -5,8 +5,7 @@
 //! the dumbbell's own hydrodynamic interaction slows its spring mode ([`hi_factor`]).
 
 use super::table::Table;
-use crate::engine::scene::never;
-use crate::engine::{Dumbbell, IntegratorSpec, Scene};
+use crate::engine::{Dumbbell, IntegratorSpec, Scene, Simulation};
 use nalgebra::Vector3;
 
 /// The linear stability limit of dt·rate for a method on the decaying mode.
@@ -45,9 +44,9 @@ fn dumbbell_scene(k0: f64, big_l: f64) -> Scene {
 /// Run 4 periods at dt; stable when no guard fires and the spring ends within 5% of λ of its rest
 /// length (its physical lag is ~λω/rate, below 1% of λ here). Returns the failure text if any.
 fn trial(k0: f64, big_l: f64, method: &str, dt: f64) -> Result<(), String> {
-    let mut s = dumbbell_scene(k0, big_l);
-    s.set_integrator(Some(spec(method, dt)));
-    s.run_periods(4.0, &never).map_err(|e| e.to_string())?;
+    let mut s = Simulation::new(dumbbell_scene(k0, big_l));
+    s.scene_mut().set_integrator(Some(spec(method, dt)));
+    s.run_periods(4.0).map_err(|e| e.to_string())?;
     let d = s.swimmer(0).map_err(|e| e.to_string())?;
     let dev = (s.length(0).map_err(|e| e.to_string())? - d.rest_length(s.time())).abs();
     if dev > 0.05 * d.lambda {

@@ -4,8 +4,7 @@
 //! steps. Marks the Pareto front and names the fastest method for each error level.
 
 use super::table::Table;
-use crate::engine::scene::never;
-use crate::engine::{Dumbbell, IntegratorSpec, Model, Scene};
+use crate::engine::{Dumbbell, IntegratorSpec, Model, Scene, Simulation};
 use nalgebra::Vector3;
 use std::f64::consts::FRAC_PI_2;
 use std::time::Instant;
@@ -65,13 +64,14 @@ fn pair(asym: bool, n1: f64, n2: f64) -> Scene {
 /// (drift, separation change) over `periods` after one settling period (the spring model's start
 /// at L(0) costs a one-off transient the rigid and averaged models do not have), in m, with the
 /// work and wall time of those periods.
-fn measure(mut s: Scene, periods: f64) -> Option<(f64, f64, u64, u64, f64)> {
-    s.run_periods(1.0, &never).ok()?;
+fn measure(s: Scene, periods: f64) -> Option<(f64, f64, u64, u64, f64)> {
+    let mut s = Simulation::new(s);
+    s.run_periods(1.0).ok()?;
     let w0 = s.stats();
     let d0 = s.displacement(0).ok()?.x + s.displacement(1).ok()?.x;
     let x0 = s.center(1).ok()?.x - s.center(0).ok()?.x;
     let t0 = Instant::now();
-    s.run_periods(periods, &never).ok()?;
+    s.run_periods(periods).ok()?;
     let secs = t0.elapsed().as_secs_f64();
     let d1 = s.displacement(0).ok()?.x + s.displacement(1).ok()?.x;
     let x1 = s.center(1).ok()?.x - s.center(0).ok()?.x;

@@ -1,4 +1,4 @@
-//! One definition per named choice (model, mobility, backend, coefficient set): each enum lists
+//! One definition per named choice (model, mobility, backend, coefficient set, overlaps): each enum lists
 //! its values once, with the user-facing name and a few words on each; parsing, display, the
 //! engine's "unknown ..." error, the script layer's "did you mean" and the `:help` check all read
 //! that one table.

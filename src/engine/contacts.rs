@@ -11,6 +11,7 @@
 //! when it is on. The averaged model places its swimmers' spheres at length ℓ for both (see
 //! [`super::averaged::AveragedSystem::set_contacts`]).
 
+use super::choice::{self, Choice, Named};
 use super::error::{invalid, Result};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -24,6 +25,45 @@ pub struct Contacts {
     /// Steric repulsion between spheres of different swimmers (microscopic and averaged models).
     pub steric: Option<Steric>,
 }
+
+impl Contacts {
+    /// What touching spheres of different swimmers do.
+    pub fn overlaps(&self) -> Overlaps {
+        if self.allow_overlap {
+            Overlaps::Allow
+        } else {
+            Overlaps::Stop
+        }
+    }
+}
+
+/// What happens when spheres of different swimmers touch (saved as [`Contacts::allow_overlap`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Overlaps {
+    /// The run stops with an error naming the two spheres.
+    #[default]
+    Stop,
+    /// They overlap, moved by the RPY tensor for overlapping spheres.
+    Allow,
+}
+
+impl Named for Overlaps {
+    const KIND: &'static str = "overlaps setting";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: Overlaps::Stop,
+            name: "stop",
+            about: "default: the run stops when spheres of different swimmers touch",
+        },
+        Choice {
+            value: Overlaps::Allow,
+            name: "allow",
+            about: "they overlap, moved by the RPY tensor for overlapping spheres",
+        },
+    ];
+}
+
+choice::inherent_names!(Overlaps);
 
 /// A harmonic repulsion F = k (δ − gap) r̂ for surface gaps below δ.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -2,11 +2,14 @@
 //!
 //! A [`Scene`] holds [`Dumbbell`] swimmers, the fluid viscosity, the [`Model`] that moves them
 //! (microscopic spheres and springs, or stroke-averaged R_H and N), the [`Mobility`] tensor and an
-//! [`IntegratorSpec`]. All quantities are SI.
+//! [`IntegratorSpec`]: state and settings. A [`Simulation`] owns a scene and runs it: recorders,
+//! the stepper and device buffers, interrupt and progress. All quantities are SI.
 
+pub mod advance;
 pub mod averaged;
 pub mod backend;
 pub mod build;
+pub mod calibrate;
 pub mod choice;
 pub mod contacts;
 pub mod error;
@@ -18,14 +21,17 @@ pub mod mobility;
 pub mod model;
 pub mod observable;
 pub mod pairs;
+pub mod plan;
 pub mod recorder;
 pub mod rigid;
 pub mod scene;
+pub mod simulation;
 mod spheres;
+pub mod stepping;
 pub mod swimmer;
 
 pub use backend::Backend;
-pub use contacts::{Contacts, Steric};
+pub use contacts::{Contacts, Overlaps, Steric};
 pub use error::{EngineError, Result};
 pub use integrators::IntegratorSpec;
 pub use mobility::Mobility;
@@ -33,4 +39,6 @@ pub use model::{Coefficients, Model};
 pub use observable::Observable;
 pub use recorder::{Recorder, Trigger};
 pub use scene::Scene;
+pub use simulation::Simulation;
+pub use stepping::RunControl;
 pub use swimmer::Dumbbell;

@@ -12,6 +12,9 @@ use super::choice::{self, Choice, Named};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+/// Water at room temperature (Pa s), the paper's μ.
+pub const DEFAULT_MU: f64 = 1e-3;
+
 /// Numbers per swimmer in the state vector.
 pub const STATE_PER_SWIMMER: usize = 6;
 

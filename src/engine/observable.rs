@@ -1,8 +1,10 @@
 //! Named quantities that can be measured on a scene now ([`Observable::evaluate`]) or recorded on a
 //! trigger ([`super::recorder`]). Each knows its name, its components and their unit.
 
+use super::advance::Probe;
 use super::error::Result;
 use super::scene::Scene;
+use super::stepping::{RunControl, Workspace};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -52,6 +54,13 @@ pub enum Observable {
 
 /// Most bins a pair-distance histogram may have (a recorder row holds one column per bin).
 pub const MAX_BINS: usize = 10_000;
+
+/// `name [unit]`, e.g. `R_H[0] [m]`.
+impl std::fmt::Display for Observable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} [{}]", self.name(), self.unit())
+    }
+}
 
 impl Observable {
     /// Short name, e.g. `R_H[0]`, `q[0,1]`.
@@ -153,13 +162,15 @@ impl Observable {
 
     /// The value now (1 or 3 components).
     pub fn evaluate(&self, s: &Scene) -> Result<Vec<f64>> {
-        self.measure(s, &super::scene::never)
+        let mut ws = Workspace::default();
+        self.measure(s, &mut Probe::new(&mut ws, &RunControl::default()))
     }
 
-    /// The value now; the probes that run a period on a copy (`delta_q`, `delta_D_H`,
-    /// `mean_speed` in the sphere models) stop at a step boundary when `interrupted()` says so,
-    /// reporting the scene's own time (the scene itself is never changed).
-    pub fn measure(&self, s: &Scene, interrupted: &dyn Fn() -> bool) -> Result<Vec<f64>> {
+    /// The value now; the observables that compare with one period later (`delta_q`,
+    /// `delta_D_H`, `mean_speed` in the sphere models) run a copy there with `probe`, which stops
+    /// at a step boundary on its control's interrupt, reporting the scene's own time (the scene
+    /// itself is never changed).
+    pub fn measure(&self, s: &Scene, probe: &mut Probe) -> Result<Vec<f64>> {
         self.check(s)?;
         let v3 = |v: Vector3<f64>| vec![v.x, v.y, v.z];
         Ok(match *self {
@@ -185,12 +196,12 @@ impl Observable {
             Observable::DistanceH(i, j) => vec![(s.center(i)? - s.center(j)?).norm()],
             Observable::DeltaQ(i, j) => {
                 let q = Observable::Q(i, j);
-                let (before, after) = Self::over_a_period(s, &q, interrupted)?;
+                let (before, after) = Self::over_a_period(s, &q, probe)?;
                 vec![before[0] - after[0]]
             }
             Observable::DeltaDistanceH(i, j) => {
                 let d = Observable::DistanceH(i, j);
-                let (before, after) = Self::over_a_period(s, &d, interrupted)?;
+                let (before, after) = Self::over_a_period(s, &d, probe)?;
                 vec![(before[0] - after[0]) / s.swimmer(i)?.ell]
             }
             Observable::Polarization => {
@@ -214,7 +225,7 @@ impl Observable {
             }
             Observable::MinGap => vec![Self::min_gap(s)],
             Observable::MeanSpeed => {
-                let v = s.center_velocities_within(interrupted)?;
+                let v = probe.center_velocities(s)?;
                 vec![v.iter().map(|v| v.norm()).sum::<f64>() / v.len().max(1) as f64]
             }
             Observable::PairDistances { bins, r_max } => Self::histogram(s, bins, r_max)?,
@@ -262,13 +273,10 @@ impl Observable {
     fn over_a_period(
         s: &Scene,
         obs: &Observable,
-        interrupted: &dyn Fn() -> bool,
+        probe: &mut Probe,
     ) -> Result<(Vec<f64>, Vec<f64>)> {
         let before = obs.evaluate(s)?;
-        let mut probe = s.clone();
-        probe
-            .run_periods(1.0, interrupted)
-            .map_err(|e| super::scene::probe_error(e, s))?;
-        Ok((before, obs.evaluate(&probe)?))
+        let later = probe.one_period_later(s)?;
+        Ok((before, obs.evaluate(&later)?))
     }
 }

@@ -1,10 +1,13 @@
 //! What is recorded ([`Observable`]s) kept apart from when ([`Trigger`]): a recorder evaluates its
 //! observables only at its trigger's times, never between them, and keeps the rows.
 
+use super::advance::Probe;
 use super::error::{invalid, require_positive, Result};
 use super::files::{write_atomically, LineStream};
+use super::integrators::require_resolvable;
 use super::observable::Observable;
 use super::scene::Scene;
+use super::stepping::{RunControl, Workspace};
 use serde::{Deserialize, Serialize};
 
 /// When a recorder takes a row.
@@ -50,29 +53,18 @@ impl Trigger {
     }
 }
 
+impl std::fmt::Display for Trigger {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.describe())
+    }
+}
+
 /// Most rows one run may add to one recorder. Rows are kept in memory (and `rec.rows` turns them
 /// into script maps), so a trigger far finer than the run needs is refused before the run starts,
 /// with the numbers; a longer recording is split into several runs.
 pub const MAX_ROWS_PER_RUN: f64 = 1e7;
 
-/// The finest interval a periodic trigger may have, relative to the times it is used at: below
-/// this, consecutive due times can no longer be told apart in f64.
-pub const MIN_RELATIVE_INTERVAL: f64 = 1e-12;
-
 const RECORD_LESS_OFTEN: &str = "record less often (a larger every_periods(n) or every_seconds(t))";
-
-/// Refuse an interval `dt` (s) that f64 cannot tell apart at times of size `scale` (s): below
-/// [`MIN_RELATIVE_INTERVAL`] of them, consecutive due times or steps round to the same time.
-/// `what` names the interval (with its value) in the message, `fix` says what to change.
-pub fn require_resolvable(what: &str, dt: f64, scale: f64, fix: &str) -> Result<()> {
-    let floor = MIN_RELATIVE_INTERVAL * scale.abs();
-    if dt > 0.0 && dt >= floor {
-        return Ok(());
-    }
-    Err(invalid!(
-        "{what} cannot be resolved at t = {scale:e} s, so it cannot advance the time: f64 tells times apart only down to ~{floor:e} s there; {fix}"
-    ))
-}
 
 /// A recorder: observables, a trigger, and the rows taken so far.
 #[derive(Debug)]
@@ -96,15 +88,21 @@ pub struct Recorder {
 impl Recorder {
     /// A recorder created on `scene` now; periodic triggers take their first row immediately.
     pub fn new(scene: &Scene, observables: Vec<Observable>, trigger: Trigger) -> Result<Self> {
-        Self::start(scene, observables, trigger, &super::scene::never)
+        let mut ws = Workspace::default();
+        Self::start(
+            scene,
+            observables,
+            trigger,
+            &mut Probe::new(&mut ws, &RunControl::default()),
+        )
     }
 
-    /// [`Recorder::new`], its first row's probes (if any) stopped when `interrupted()` says so.
+    /// [`Recorder::new`], its first row's probe runs (if any) made by `probe`.
     pub fn start(
         scene: &Scene,
         observables: Vec<Observable>,
         trigger: Trigger,
-        interrupted: &dyn Fn() -> bool,
+        probe: &mut Probe,
     ) -> Result<Self> {
         trigger.validate()?;
         for o in &observables {
@@ -136,11 +134,11 @@ impl Recorder {
             stream: None,
         };
         if r.interval.is_some() {
-            r.take(scene, interrupted)?;
+            r.take(scene, probe)?;
             r.next_k = 1;
         } else if let Trigger::AtTimes(ts) = &r.trigger {
             if ts.contains(&scene.time()) {
-                r.take(scene, interrupted)?;
+                r.take(scene, probe)?;
             }
         }
         Ok(r)
@@ -179,12 +177,7 @@ impl Recorder {
     }
 
     /// Take rows due at the scene's current time (after a run segment ended there).
-    pub fn fire(
-        &mut self,
-        scene: &Scene,
-        end_of_run: bool,
-        interrupted: &dyn Fn() -> bool,
-    ) -> Result<()> {
+    pub fn fire(&mut self, scene: &Scene, end_of_run: bool, probe: &mut Probe) -> Result<()> {
         let t = scene.time();
         let due = match (&self.trigger, self.interval) {
             (_, Some(dt)) => t >= self.start + self.next_k as f64 * dt,
@@ -193,7 +186,7 @@ impl Recorder {
             _ => false,
         };
         if due {
-            self.take(scene, interrupted)?;
+            self.take(scene, probe)?;
         }
         if let Some(dt) = self.interval {
             // Skip samples a run already passed (never two rows at one time), in O(1): the
@@ -241,10 +234,10 @@ impl Recorder {
         Ok(())
     }
 
-    fn take(&mut self, scene: &Scene, interrupted: &dyn Fn() -> bool) -> Result<()> {
+    fn take(&mut self, scene: &Scene, probe: &mut Probe) -> Result<()> {
         let mut row = vec![scene.time()];
         for o in &self.observables {
-            row.extend(o.measure(scene, interrupted)?);
+            row.extend(o.measure(scene, probe)?);
         }
         // The row is kept in memory even if its line cannot be written.
         let streamed = match &mut self.stream {

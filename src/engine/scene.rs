@@ -1,38 +1,28 @@
-//! A scene: the swimmers, the fluid, the model that moves them, and the integrator. This is the
-//! engine's single entry point for the script layer.
+//! A scene: the swimmers, the fluid, the model that moves them, and the integrator: state and
+//! settings only. What runs it (recorders, stepper, device buffers, interrupt and progress) is a
+//! [`super::simulation::Simulation`].
 //!
 //! This file holds the state, its configuration and plain reading; the rest of `Scene` lives in
-//! child modules: `dynamics` (the models' right-hand side and what it says now), `plan` (CPU or
-//! GPU for the next run), `run` (runs, their checks, recorders, progress) and `save` (JSON, and
-//! validation on load).
+//! child modules: `dynamics` (the models' right-hand side and what it says now) and `save` (JSON,
+//! and validation on load).
 
 use super::averaged::AveragedSystem;
-use super::backend::{self, Backend};
-use super::contacts::{Contacts, Steric};
-use super::error::{
-    invalid, require_finite, require_positive, unsupported, EngineError, Result, Setting,
-};
-use super::gpu::{GpuModel, GpuRun, RunOutcome, UniformSteps};
-use super::integrators::{uniform_steps, IntegratorSpec, OdeSystem, Stats, Stepper};
+use super::backend::Backend;
+use super::contacts::{Contacts, Overlaps, Steric};
+use super::error::{invalid, require_finite, require_positive, unsupported, Result, Setting};
+use super::integrators::{IntegratorSpec, OdeSystem, Stats};
 use super::micro::MicroSystem;
 use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
-use super::recorder::Recorder;
 use super::rigid::RigidSystem;
 use super::swimmer::{unit_direction, Dumbbell};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 mod dynamics;
-mod plan;
-mod run;
 mod save;
-pub use crate::engine::build::lattice_scene;
-pub use run::MAX_FIXED_STEPS_PER_RUN;
+pub use super::model::DEFAULT_MU;
 pub use save::{MAX_TIME_IN_PERIODS, SAVE_FORMAT};
-
-/// Water at room temperature (Pa s), the paper's μ.
-pub const DEFAULT_MU: f64 = 1e-3;
 
 /// The microscopic model's default RK4 step times the stiffest spring's relaxation rate. RK4 is
 /// stable up to 2.785; at 0.8 the stroke-induced wobble of an isolated asymmetric dumbbell's R_H
@@ -52,7 +42,7 @@ pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 /// State per swimmer: see [`super::model`]. Positions are SI (m), times s. The engine works in SI
 /// throughout: f64 carries relative precision independently of scale, and the adaptive error control
 /// measures each component against a physical scale (stroke λ, drift λ³Λ/ℓ³), not against 1.
-#[derive(Serialize, Deserialize)]
+#[derive(Clone, Serialize, Deserialize)]
 pub struct Scene {
     mu: f64,
     model: Model,
@@ -66,32 +56,18 @@ pub struct Scene {
     cutoff: Option<f64>,
     /// `None`: the model's default.
     integrator: Option<IntegratorSpec>,
-    swimmers: Vec<Dumbbell>,
+    /// The swimmers' parameters (the steppers read them).
+    pub(in crate::engine) swimmers: Vec<Dumbbell>,
     /// Hydrodynamic centre of each swimmer that the displacement in `state` is measured from.
-    base: Vec<Vector3<f64>>,
-    state: Vec<f64>,
-    time: f64,
-    stats: Stats,
+    pub(in crate::engine) base: Vec<Vector3<f64>>,
+    /// See [`super::model`]; the steppers advance it.
+    pub(in crate::engine) state: Vec<f64>,
+    pub(in crate::engine) time: f64,
+    pub(in crate::engine) stats: Stats,
     /// Where the dynamics run (saved; "cpu" for files from before backends existed).
     #[serde(default)]
     backend: Backend,
-    /// Device buffers of the last GPU run, reused while the scene's size and method stay.
-    #[serde(skip)]
-    gpu: Option<GpuRun>,
-    /// The stepper of the last run, kept so an adaptive one remembers its step size.
-    #[serde(skip)]
-    stepper: Option<(IntegratorSpec, Box<dyn Stepper>)>,
-    /// Recorders: operations on the scene, not its state (neither saved nor cloned).
-    #[serde(skip)]
-    recorders: Vec<Recorder>,
-    /// Told the scene time as a run advances (neither saved nor cloned).
-    #[serde(skip)]
-    progress: Option<Progress>,
 }
-
-/// A run's progress report: called with the scene time after every CPU step and after every
-/// device run segment, e.g. to draw a progress bar. It must be cheap.
-pub type Progress = std::sync::Arc<dyn Fn(f64) + Send + Sync>;
 
 impl Default for Scene {
     fn default() -> Self {
@@ -109,35 +85,6 @@ impl Default for Scene {
             time: 0.0,
             stats: Stats::default(),
             backend: Backend::default(),
-            gpu: None,
-            stepper: None,
-            recorders: Vec::new(),
-            progress: None,
-        }
-    }
-}
-
-/// A clone is a new simulation from the same state: it has no recorders and a fresh stepper.
-impl Clone for Scene {
-    fn clone(&self) -> Self {
-        Scene {
-            mu: self.mu,
-            model: self.model,
-            mobility: self.mobility,
-            coefficients: self.coefficients,
-            contacts: self.contacts,
-            cutoff: self.cutoff,
-            integrator: self.integrator,
-            swimmers: self.swimmers.clone(),
-            base: self.base.clone(),
-            state: self.state.clone(),
-            time: self.time,
-            stats: self.stats,
-            backend: self.backend,
-            gpu: None,
-            stepper: None,
-            recorders: Vec::new(),
-            progress: None,
         }
     }
 }
@@ -290,6 +237,11 @@ impl Scene {
         self.contacts.allow_overlap = allow;
     }
 
+    /// What touching spheres of different swimmers do.
+    pub fn set_overlaps(&mut self, o: Overlaps) {
+        self.set_allow_overlap(o == Overlaps::Allow);
+    }
+
     /// Switch the steric repulsion between swimmers on (`Some`) or off.
     pub fn set_steric(&mut self, steric: Option<Steric>) {
         self.contacts.steric = steric;
@@ -360,7 +312,7 @@ impl Scene {
         self.backend
     }
 
-    /// Choose where the dynamics run (checked when the scene runs: see [`Scene::backend_info`]).
+    /// Choose where the dynamics run (checked when the scene runs: see [`super::plan`]).
     pub fn set_backend(&mut self, b: Backend) {
         self.backend = b;
     }
@@ -538,18 +490,4 @@ impl Scene {
             .map(|d| d.relaxation_rate(self.mu))
             .fold(0.0, f64::max)
     }
-}
-
-/// An interrupt of a probe run on a copy of `s`, reported at `s`'s own time (the copy's time means
-/// nothing to the user: `s` itself did not move).
-pub(crate) fn probe_error(e: EngineError, s: &Scene) -> EngineError {
-    match e {
-        EngineError::Interrupted { .. } => EngineError::Interrupted { time: s.time },
-        other => other,
-    }
-}
-
-/// A run that is never interrupted.
-pub fn never() -> bool {
-    false
 }

@@ -8,6 +8,16 @@ use rhai::{Array, Dynamic, EvalAltResult, Position, FLOAT, INT};
 /// Result type of script-visible functions.
 pub type ScriptResult<T> = Result<T, Box<EvalAltResult>>;
 
+/// Register a script type's `to_string` and `to_debug` as its `Display`: the one text `print`,
+/// string interpolation, `debug` and the REPL's `show` give.
+pub fn register_display<T: std::fmt::Display + Clone + Send + Sync + 'static>(
+    engine: &mut rhai::Engine,
+) {
+    engine
+        .register_fn("to_string", |x: &mut T| x.to_string())
+        .register_fn("to_debug", |x: &mut T| x.to_string());
+}
+
 /// A runtime error with this message; Rhai fills in the script position of the call.
 pub fn script_error(msg: impl Into<String>) -> Box<EvalAltResult> {
     EvalAltResult::ErrorRuntime(Dynamic::from(msg.into()), Position::NONE).into()

@@ -77,6 +77,7 @@ impl std::fmt::Display for DumbbellSpec {
 
 /// Register the `Dumbbell` type and `dumbbell(...)`.
 pub fn register(engine: &mut Engine) {
+    super::convert::register_display::<DumbbellSpec>(engine);
     engine
         .register_type_with_name::<DumbbellSpec>("Dumbbell")
         .register_fn("dumbbell", |m: Map| DumbbellSpec::from_map(&m))
@@ -89,8 +90,6 @@ pub fn register(engine: &mut Engine) {
                 .to_radians()
                 .rem_euclid(std::f64::consts::TAU))
         })
-        .register_fn("to_string", |d: &mut DumbbellSpec| d.to_string())
-        .register_fn("to_debug", |d: &mut DumbbellSpec| d.to_string())
         .register_get("a1", |d: &mut DumbbellSpec| d.params.a1)
         .register_get("a2", |d: &mut DumbbellSpec| d.params.a2)
         .register_get("ell", |d: &mut DumbbellSpec| d.params.ell)

@@ -18,6 +18,7 @@ mod plot_api;
 mod progress;
 mod render;
 mod scene_api;
+mod scene_settings_api;
 mod show;
 mod signatures;
 pub mod stdlib;

@@ -1,7 +1,7 @@
 //! Observables as script values (type `Observable`), `s.observe(obs)`, triggers (type `Trigger`),
 //! and recorders (type `Recorder`): `s.record([...], trigger)`, `.rows`, `.to_csv(path)`.
 
-use super::convert::{index, lift, number, script_error, vector3, ScriptResult};
+use super::convert::{index, lift, number, register_display, script_error, vector3, ScriptResult};
 use super::scene_api::SceneHandle;
 use crate::engine::{Observable, Recorder, Trigger};
 use nalgebra::Vector3;
@@ -14,9 +14,15 @@ pub struct RecorderHandle {
     id: usize,
 }
 
+/// One line: `Recorder(3 rows of R_H[0].x, ..., every 0.5 periods)`.
+impl std::fmt::Display for RecorderHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.describe())
+    }
+}
+
 impl RecorderHandle {
-    /// One-line description (what `print(rec)` shows).
-    pub fn describe(&self) -> String {
+    fn describe(&self) -> String {
         self.with(|rec| {
             format!(
                 "Recorder({} rows of {}, {})",
@@ -83,14 +89,11 @@ fn observables_of(list: &Array) -> ScriptResult<Vec<Observable>> {
 
 /// Register observables, triggers and recorders.
 pub fn register(engine: &mut Engine) {
+    register_display::<Observable>(engine);
+    register_display::<Trigger>(engine);
+    register_display::<RecorderHandle>(engine);
     engine
         .register_type_with_name::<Observable>("Observable")
-        .register_fn("to_string", |o: &mut Observable| {
-            format!("{} [{}]", o.name(), o.unit())
-        })
-        .register_fn("to_debug", |o: &mut Observable| {
-            format!("{} [{}]", o.name(), o.unit())
-        })
         .register_get("name", |o: &mut Observable| o.name())
         .register_get("unit", |o: &mut Observable| o.unit().to_string());
 
@@ -160,14 +163,12 @@ pub fn register(engine: &mut Engine) {
         .register_fn(
             "observe",
             |s: &mut SceneHandle, o: Observable| -> ScriptResult<Dynamic> {
-                lift(o.measure(&s.borrow(), &super::interrupt::requested)).map(value)
+                lift(s.borrow_mut().measure(&o)).map(value)
             },
         );
 
     engine
         .register_type_with_name::<Trigger>("Trigger")
-        .register_fn("to_string", |t: &mut Trigger| t.describe())
-        .register_fn("to_debug", |t: &mut Trigger| t.describe())
         .register_fn("every_periods", |n: Dynamic| -> ScriptResult<Trigger> {
             let t = Trigger::EveryPeriods(number("every_periods(n): n", &n)?);
             lift(t.validate()).map(|_| t)
@@ -194,29 +195,10 @@ pub fn register(engine: &mut Engine) {
             |s: &mut SceneHandle, list: Array, every: Dynamic| -> ScriptResult<RecorderHandle> {
                 let obs = observables_of(&list)?;
                 let trigger = trigger_of(&every)?;
-                let rec = lift(Recorder::start(
-                    &s.borrow(),
-                    obs,
-                    trigger,
-                    &super::interrupt::requested,
-                ))?;
-                let id = s.borrow_mut().add_recorder(rec);
+                let id = lift(s.borrow_mut().record(obs, trigger))?;
                 Ok(RecorderHandle {
                     scene: s.clone(),
                     id,
-                })
-            },
-        )
-        .register_fn("to_string", |r: &mut RecorderHandle| r.describe())
-        .register_fn(
-            "to_debug",
-            |r: &mut RecorderHandle| -> ScriptResult<String> {
-                r.with(|rec| {
-                    format!(
-                        "Recorder({} rows, {})",
-                        rec.rows.len(),
-                        rec.trigger.describe()
-                    )
                 })
             },
         )

@@ -3,7 +3,7 @@
 //! into pipes or files). `SWIMLAB_PROGRESS=0` turns it off. It is cleared when the run ends,
 //! however it ends (done, error, Ctrl-C).
 
-use crate::engine::scene::Progress;
+use crate::engine::stepping::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::{Arc, Mutex};

@@ -1,88 +1,77 @@
 //! `scene()` and the `Scene` type: build, configure, run and read a simulation from a script.
 //!
-//! A scene is big and stateful, so scripts hold a cheap handle (`Arc<RwLock<Scene>>`, shareable
-//! because `sweep` runs script closures on several threads): `let t = s;` names the same scene,
-//! as in Python.
+//! A scene is big and stateful, so scripts hold a cheap handle on its simulation
+//! (`Arc<RwLock<Simulation>>`, shareable because `sweep` runs script closures on several threads):
+//! `let t = s;` names the same scene, as in Python. Every run of a script's scene stops on Ctrl-C
+//! ([`interrupt`]).
 
-use super::convert::{array3, index, lift, number, script_error, unknown_choice, ScriptResult};
+use super::convert::{array3, index, lift, number, script_error, ScriptResult};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
-use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric};
-use rhai::{Array, Dynamic, Engine, ImmutableString, INT};
+use crate::engine::{Backend, Scene, Simulation};
+use rhai::{Array, Dynamic, Engine, INT};
 use std::sync::{Arc, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 /// The largest scene file `load_scene` reads (bytes): a saved scene of 10^5 swimmers is ~60 MB.
 pub const MAX_SCENE_FILE_BYTES: u64 = 256 << 20;
 
-/// A script's handle on a scene (Rhai type `Scene`).
-#[derive(Debug, Clone, Default)]
-pub struct SceneHandle(pub Arc<RwLock<Scene>>);
+/// A script's handle on a scene and its simulation (Rhai type `Scene`).
+#[derive(Debug, Clone)]
+pub struct SceneHandle(pub Arc<RwLock<Simulation>>);
+
+impl Default for SceneHandle {
+    fn default() -> Self {
+        SceneHandle::new(Scene::default())
+    }
+}
 
 impl SceneHandle {
-    /// Wrap a scene.
+    /// A simulation of `scene` whose runs stop on Ctrl-C.
     pub fn new(scene: Scene) -> Self {
-        SceneHandle(Arc::new(RwLock::new(scene)))
+        let mut sim = Simulation::new(scene);
+        sim.set_interrupt(Some(Arc::new(interrupt::requested)));
+        SceneHandle(Arc::new(RwLock::new(sim)))
     }
 
-    /// Read the scene. A lock poisoned by a panic elsewhere still holds a consistent scene (every
-    /// change is made whole or not at all), so it is read anyway.
-    pub fn borrow(&self) -> RwLockReadGuard<'_, Scene> {
+    /// Read the simulation (and through it the scene). A lock poisoned by a panic elsewhere still
+    /// holds a consistent one (every change is made whole or not at all), so it is read anyway.
+    pub fn borrow(&self) -> RwLockReadGuard<'_, Simulation> {
         self.0.read().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Change the scene.
-    pub fn borrow_mut(&self) -> RwLockWriteGuard<'_, Scene> {
+    /// Change the simulation.
+    pub fn borrow_mut(&self) -> RwLockWriteGuard<'_, Simulation> {
         self.0.write().unwrap_or_else(|e| e.into_inner())
     }
 
-    fn with<T>(&self, f: impl FnOnce(&Scene) -> crate::engine::Result<T>) -> ScriptResult<T> {
+    pub(super) fn with<T>(
+        &self,
+        f: impl FnOnce(&Scene) -> crate::engine::Result<T>,
+    ) -> ScriptResult<T> {
         lift(f(&self.borrow()))
     }
 
-    fn with_mut<T>(
+    /// Change the scene's settings or swimmers.
+    pub(super) fn with_mut<T>(
         &self,
         f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
+        lift(f(self.borrow_mut().scene_mut()))
+    }
+
+    /// Run or measure.
+    fn with_sim<T>(
+        &self,
+        f: impl FnOnce(&mut Simulation) -> crate::engine::Result<T>,
+    ) -> ScriptResult<T> {
         lift(f(&mut self.borrow_mut()))
     }
-}
 
-fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {
-    v.clone()
-        .into_immutable_string()
-        .map(|s| s.to_string())
-        .map_err(|t| script_error(format!("{what} must be a string, got {v} ({t})")))
-}
-
-/// `s.steric = #{ range, stiffness }` (m, N/m) or `()` for none.
-fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
-    const FIX: &str =
-        "use s.steric = #{ range: 1e-7, stiffness: 1e-3 } (m, N/m), or s.steric = () for none";
-    if v.is_unit() {
-        return Ok(None);
-    }
-    let Some(map) = v.clone().try_cast::<rhai::Map>() else {
-        return Err(script_error(format!(
-            "s.steric must be a map or (), got {v}; {FIX}"
-        )));
-    };
-    let (mut range, mut stiffness) = (None, None);
-    for (k, val) in &map {
-        match k.as_str() {
-            "range" => range = Some(number("steric range", val)?),
-            "stiffness" => stiffness = Some(number("steric stiffness", val)?),
-            other => {
-                return Err(script_error(format!(
-                    "s.steric: unknown key \"{other}\"; {FIX}"
-                )))
-            }
-        }
-    }
-    match (range, stiffness) {
-        (Some(r), Some(k)) => lift(Steric::new(r, k)).map(Some),
-        _ => Err(script_error(format!(
-            "s.steric needs both range and stiffness; {FIX}"
-        ))),
+    /// Put `trial` in place of the scene (the recorders stay); returns the new count.
+    fn replace(&self, trial: Scene) -> INT {
+        let mut sim = self.borrow_mut();
+        sim.replace_scene(trial);
+        sim.count() as INT
     }
 }
 
@@ -92,6 +81,13 @@ fn swimmer_index(v: &Dynamic) -> ScriptResult<usize> {
         Err(t) => Err(script_error(format!(
             "a swimmer index must be an integer such as 0, got {v} ({t})"
         ))),
+    }
+}
+
+/// [`summary`] of the scene.
+impl std::fmt::Display for SceneHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&summary(&self.borrow()))
     }
 }
 
@@ -149,7 +145,7 @@ fn add_random(
             }
         }
     }
-    let mut trial = s.borrow().clone();
+    let mut trial = s.borrow().scene().clone();
     let side = lift(box_side(n as usize, &d.params, phi))?;
     lift(random_suspension(
         &mut trial,
@@ -160,32 +156,26 @@ fn add_random(
         phases,
         seed as u64,
     ))?;
-    let mut scene = s.borrow_mut();
-    let recorders_kept = std::mem::replace(&mut *scene, trial);
-    scene.adopt_recorders(recorders_kept);
-    Ok(scene.count() as INT)
+    Ok(s.replace(trial))
 }
 
 /// `s.add_at(d, centres)`: a copy of d (its orientation and phase) at every centre of the array,
 /// in order; all or nothing (the scene is unchanged if one does not fit).
 fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult<INT> {
-    let mut trial = s.borrow().clone();
+    let mut trial = s.borrow().scene().clone();
     for (k, c) in centres.iter().enumerate() {
         let c = super::convert::vector3(&format!("add_at: centre {k}"), c)?;
         lift(trial.add(d.params, c, d.dir))
             .map_err(|e| script_error(format!("add_at: centre {k}: {e}")))?;
     }
-    let mut scene = s.borrow_mut();
-    let recorders_kept = std::mem::replace(&mut *scene, trial);
-    scene.adopt_recorders(recorders_kept);
-    Ok(scene.count() as INT)
+    Ok(s.replace(trial))
 }
 
 /// Run `f` with a progress bar over the next `duration` seconds (only at a terminal).
 fn with_bar<T>(
-    sc: &mut Scene,
+    sc: &mut Simulation,
     duration: f64,
-    f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
+    f: impl FnOnce(&mut Simulation) -> crate::engine::Result<T>,
 ) -> crate::engine::Result<T> {
     let t0 = sc.time();
     match super::progress::RunBar::start(t0, t0 + duration, sc.period().ok()) {
@@ -204,9 +194,8 @@ fn with_bar<T>(
 pub fn register(engine: &mut Engine) {
     engine
         .register_type_with_name::<SceneHandle>("Scene")
-        .register_fn("scene", SceneHandle::default)
-        .register_fn("to_string", |s: &mut SceneHandle| summary(&s.borrow()))
-        .register_fn("to_debug", |s: &mut SceneHandle| summary(&s.borrow()));
+        .register_fn("scene", SceneHandle::default);
+    super::convert::register_display::<SceneHandle>(engine);
 
     // Building.
     engine.register_fn(
@@ -253,126 +242,7 @@ pub fn register(engine: &mut Engine) {
         },
     );
 
-    // Properties.
-    engine
-        .register_get("time", |s: &mut SceneHandle| s.borrow().time())
-        .register_get("count", |s: &mut SceneHandle| s.borrow().count() as INT)
-        .register_get("period", |s: &mut SceneHandle| s.with(|sc| sc.period()))
-        .register_get("stiff_rate", |s: &mut SceneHandle| s.borrow().stiff_rate())
-        .register_get("mu", |s: &mut SceneHandle| s.borrow().mu())
-        .register_set(
-            "mu",
-            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-                let mu = number("mu", &v)?;
-                s.with_mut(|sc| sc.set_mu(mu))
-            },
-        )
-        .register_get("model", |s: &mut SceneHandle| ImmutableString::from(s.borrow().model().name()))
-        .register_set(
-            "model",
-            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-                let name = string_arg("model", &v)?;
-                let m = lift(Model::parse(&name))?;
-                s.borrow_mut().set_model(m);
-                Ok(())
-            },
-        )
-        .register_get("mobility", |s: &mut SceneHandle| ImmutableString::from(s.borrow().mobility().name()))
-        .register_set(
-            "mobility",
-            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-                let name = string_arg("mobility", &v)?;
-                let m = lift(Mobility::parse(&name))?;
-                s.borrow_mut().set_mobility(m);
-                Ok(())
-            },
-        )
-        .register_get("backend", |s: &mut SceneHandle| ImmutableString::from(s.borrow().backend().name()))
-        .register_set(
-            "backend",
-            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-                let name = string_arg("backend", &v)?;
-                let b = lift(Backend::parse(&name))?;
-                if b == Backend::Gpu {
-                    crate::engine::gpu::device().map_err(|e| {
-                        script_error(format!(
-                            "s.backend = \"gpu\": {e}; use s.backend = \"cpu\" or \"auto\""
-                        ))
-                    })?;
-                }
-                s.borrow_mut().set_backend(b);
-                Ok(())
-            },
-        )
-        .register_get("backend_info", |s: &mut SceneHandle| {
-            s.with(|sc| sc.backend_info()).map(ImmutableString::from)
-        })
-        .register_get("coefficients", |s: &mut SceneHandle| ImmutableString::from(s.borrow().coefficients().name()))
-        .register_set(
-            "coefficients",
-            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-                let name = string_arg("coefficients", &v)?;
-                let c = lift(Coefficients::parse(&name))?;
-                s.borrow_mut().set_coefficients(c);
-                Ok(())
-            },
-        )
-        .register_get("overlaps", |s: &mut SceneHandle| {
-            ImmutableString::from(if s.borrow().contacts().allow_overlap { "allow" } else { "stop" })
-        })
-        .register_set(
-            "overlaps",
-            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-                let name = string_arg("overlaps", &v)?;
-                let allow = match name.as_str() {
-                    "stop" => false,
-                    "allow" => true,
-                    _ => return Err(unknown_choice("overlaps setting", &name, &["stop", "allow"])),
-                };
-                s.borrow_mut().set_allow_overlap(allow);
-                Ok(())
-            },
-        )
-        .register_get("steric", |s: &mut SceneHandle| match s.borrow().contacts().steric {
-            Some(st) => {
-                let mut m = rhai::Map::new();
-                m.insert("range".into(), Dynamic::from_float(st.range));
-                m.insert("stiffness".into(), Dynamic::from_float(st.stiffness));
-                Dynamic::from_map(m)
-            }
-            None => Dynamic::UNIT,
-        })
-        .register_set("steric", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-            s.borrow_mut().set_steric(steric_arg(&v)?);
-            Ok(())
-        })
-        .register_get("cutoff", |s: &mut SceneHandle| {
-            s.borrow().cutoff().map_or(Dynamic::UNIT, Dynamic::from_float)
-        })
-        .register_set("cutoff", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-            let c = if v.is_unit() { None } else { Some(number("s.cutoff", &v)?) };
-            s.with_mut(|sc| sc.set_cutoff(c))
-        })
-        .register_get("integrator", |s: &mut SceneHandle| s.borrow().integrator())
-        .register_set(
-            "integrator",
-            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-                if let Some(spec) = v.clone().try_cast::<IntegratorSpec>() {
-                    s.borrow_mut().set_integrator(Some(spec));
-                    return Ok(());
-                }
-                match v.clone().into_immutable_string() {
-                    Ok(name) if name == "default" => {
-                        s.borrow_mut().set_integrator(None);
-                        Ok(())
-                    }
-                    Ok(name) => Err(unknown_choice("integrator", &name, &["default"])),
-                    Err(t) => Err(script_error(format!(
-                        "integrator must be euler(dt), rk4(dt), dopri5(rtol), rosw(rtol) or \"default\", got {v} ({t})"
-                    ))),
-                }
-            },
-        );
+    super::scene_settings_api::register(engine);
 
     // Reading one swimmer.
     engine
@@ -467,7 +337,7 @@ pub fn register(engine: &mut Engine) {
             },
         )
         .register_fn("copy", |s: &mut SceneHandle| {
-            SceneHandle::new(s.borrow().clone())
+            SceneHandle::new(s.borrow().scene().clone())
         })
         .register_fn(
             "save",
@@ -497,16 +367,16 @@ pub fn register(engine: &mut Engine) {
             "run",
             |s: &mut SceneHandle, duration: Dynamic| -> ScriptResult<()> {
                 let d = number("run(duration)", &duration)?;
-                s.with_mut(|sc| with_bar(sc, d, |sc| sc.run(d, &interrupt::requested)))
+                s.with_sim(|sim| with_bar(sim, d, |sim| sim.run(d)))
             },
         )
         .register_fn(
             "run_periods",
             |s: &mut SceneHandle, n: Dynamic| -> ScriptResult<()> {
                 let n = number("run_periods(n)", &n)?;
-                s.with_mut(|sc| {
-                    let d = sc.period().map_or(0.0, |t| n * t);
-                    with_bar(sc, d, |sc| sc.run_periods(n, &interrupt::requested))
+                s.with_sim(|sim| {
+                    let d = sim.period().map_or(0.0, |t| n * t);
+                    with_bar(sim, d, |sim| sim.run_periods(n))
                 })
             },
         )

@@ -3,30 +3,23 @@
 
 use super::dumbbell_api::DumbbellSpec;
 use super::observable_api::RecorderHandle;
-use super::scene_api::{summary, SceneHandle};
+use super::scene_api::SceneHandle;
 use crate::engine::{IntegratorSpec, Observable, Trigger};
 use rhai::{Array, Dynamic, Map};
 
+/// The text of the first of `types` that `v` holds, through its `Display` (the one the type's
+/// `to_string` uses).
+macro_rules! displayed {
+    ($v:expr; $($t:ty),+) => {
+        $(if let Some(x) = $v.read_lock::<$t>() {
+            return x.to_string();
+        })+
+    };
+}
+
 /// Text for a value printed by the REPL.
 pub fn show(v: &Dynamic) -> String {
-    if let Some(s) = v.clone().try_cast::<SceneHandle>() {
-        return summary(&s.borrow());
-    }
-    if let Some(d) = v.clone().try_cast::<DumbbellSpec>() {
-        return d.to_string();
-    }
-    if let Some(i) = v.clone().try_cast::<IntegratorSpec>() {
-        return i.to_string();
-    }
-    if let Some(o) = v.clone().try_cast::<Observable>() {
-        return format!("{} [{}]", o.name(), o.unit());
-    }
-    if let Some(t) = v.clone().try_cast::<Trigger>() {
-        return t.describe();
-    }
-    if let Some(r) = v.clone().try_cast::<RecorderHandle>() {
-        return r.describe();
-    }
+    displayed!(v; SceneHandle, DumbbellSpec, IntegratorSpec, Observable, Trigger, RecorderHandle);
     if let Some(a) = v.clone().try_cast::<Array>() {
         return format!("[{}]", a.iter().map(show).collect::<Vec<_>>().join(", "));
     }

@@ -3,8 +3,7 @@
 
 use nalgebra::Vector3;
 use std::f64::consts::FRAC_PI_2;
-use swimlab::engine::scene::never;
-use swimlab::engine::{Dumbbell, IntegratorSpec, Scene};
+use swimlab::engine::{Dumbbell, IntegratorSpec, Scene, Simulation};
 
 /// ℓ = 5 µm.
 pub const ELL: f64 = 5e-6;
@@ -50,14 +49,17 @@ pub fn mirror_inwards(d_over_ell: f64, asymmetric: bool) -> Scene {
 }
 
 /// Per-period change of the mean displacement and of the separation along x (in ℓ), measured over
-/// `periods` periods after one settling period.
-pub fn drift_per_period(s: &mut Scene, periods: f64) -> (f64, f64) {
-    s.run_periods(1.0, &never).unwrap();
+/// `periods` periods after one settling period (`s` is left at the end of the run).
+pub fn drift_per_period(scene: &mut Scene, periods: f64) -> (f64, f64) {
+    let mut sim = Simulation::new(std::mem::take(scene));
+    let s = &mut sim;
+    s.run_periods(1.0).unwrap();
     let x = |s: &Scene, i| s.displacement(i).unwrap().x + s.raw_state().1[i].x;
     let d = |s: &Scene, i| s.displacement(i).unwrap().x;
     let (m0, s0) = ((d(s, 0) + d(s, 1)) / 2.0, x(s, 1) - x(s, 0));
-    s.run_periods(periods, &never).unwrap();
+    s.run_periods(periods).unwrap();
     let (m1, s1) = ((d(s, 0) + d(s, 1)) / 2.0, x(s, 1) - x(s, 0));
+    *scene = sim.into_scene();
     ((m1 - m0) / periods / ELL, (s1 - s0) / periods / ELL)
 }
 

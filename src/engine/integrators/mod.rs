@@ -16,5 +16,8 @@ pub use dopri5::Dopri5;
 pub use euler::Euler;
 pub use rk4::Rk4;
 pub use rosenbrock::Rosenbrock;
-pub use spec::IntegratorSpec;
-pub use system::{uniform_steps, OdeSystem, Problem, Stats, StepFailure, Stepper};
+pub use spec::{IntegratorSpec, Method, METHODS};
+pub use system::{
+    require_resolvable, uniform_steps, OdeSystem, Problem, Stats, StepFailure, Stepper,
+    MIN_RELATIVE_INTERVAL,
+};

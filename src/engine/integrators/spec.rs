@@ -31,7 +31,77 @@ pub enum IntegratorSpec {
     },
 }
 
+/// One integrator method as users name it: the name, its one parameter, and a checked
+/// constructor. The script's constructors, `Display` and messages read this table.
+#[derive(Debug, Clone, Copy)]
+pub struct Method {
+    /// The name (`rk4`), also the script constructor's.
+    pub name: &'static str,
+    /// Its parameter (`dt`) and what that is.
+    pub parameter: &'static str,
+    /// What the parameter means, with its unit.
+    pub parameter_about: &'static str,
+    /// A few words on the method.
+    pub about: &'static str,
+    /// The checked constructor.
+    pub make: fn(f64) -> Result<IntegratorSpec>,
+}
+
+/// Every method, in the order messages list them.
+pub const METHODS: &[Method] = &[
+    Method {
+        name: "euler",
+        parameter: "dt",
+        parameter_about: "the step in s",
+        about: "forward Euler, fixed step",
+        make: IntegratorSpec::euler,
+    },
+    Method {
+        name: "rk4",
+        parameter: "dt",
+        parameter_about: "the step in s",
+        about: "classic Runge-Kutta, fixed step",
+        make: IntegratorSpec::rk4,
+    },
+    Method {
+        name: "dopri5",
+        parameter: "rtol",
+        parameter_about: "the relative tolerance",
+        about: "adaptive Dormand-Prince 5(4)",
+        make: IntegratorSpec::dopri5,
+    },
+    Method {
+        name: "rosw",
+        parameter: "rtol",
+        parameter_about: "the relative tolerance",
+        about: "adaptive Rosenbrock-W ROS34PW2, for stiff springs",
+        make: IntegratorSpec::rosw,
+    },
+];
+
 impl IntegratorSpec {
+    /// The method's entry in [`METHODS`].
+    pub fn method(&self) -> &'static Method {
+        let name = match self {
+            IntegratorSpec::Euler { .. } => "euler",
+            IntegratorSpec::Rk4 { .. } => "rk4",
+            IntegratorSpec::Dopri5 { .. } => "dopri5",
+            IntegratorSpec::Rosw { .. } => "rosw",
+        };
+        METHODS
+            .iter()
+            .find(|m| m.name == name)
+            .expect("every method has an entry in METHODS")
+    }
+
+    /// The one parameter's value: the step (s) or the tolerance.
+    pub fn parameter(&self) -> f64 {
+        match *self {
+            IntegratorSpec::Euler { dt } | IntegratorSpec::Rk4 { dt } => dt,
+            IntegratorSpec::Dopri5 { rtol } | IntegratorSpec::Rosw { rtol } => rtol,
+        }
+    }
+
     /// Forward Euler, checked.
     pub fn euler(dt: f64) -> Result<Self> {
         require_positive("euler(dt): dt", dt, "s")?;
@@ -78,11 +148,6 @@ fn check_rtol(method: &str, rtol: f64) -> Result<f64> {
 
 impl fmt::Display for IntegratorSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            IntegratorSpec::Euler { dt } => write!(f, "euler({dt:e})"),
-            IntegratorSpec::Rk4 { dt } => write!(f, "rk4({dt:e})"),
-            IntegratorSpec::Dopri5 { rtol } => write!(f, "dopri5({rtol:e})"),
-            IntegratorSpec::Rosw { rtol } => write!(f, "rosw({rtol:e})"),
-        }
+        write!(f, "{}({:e})", self.method().name, self.parameter())
     }
 }

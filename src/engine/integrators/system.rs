@@ -1,6 +1,6 @@
 //! The contract between models and integrators.
 
-use crate::engine::error::Setting;
+use crate::engine::error::{invalid, Setting};
 use serde::{Deserialize, Serialize};
 
 /// A first-order system dy/dt = f(t, y) with the hooks the integrators need.
@@ -137,4 +137,26 @@ pub(crate) fn tolerance_failure(time: f64, h: f64, rejects: u32) -> StepFailure 
             fixes: Vec::new(),
         },
     }
+}
+
+/// The finest interval (a step, a recorder's period) relative to the times it is used at: below
+/// this, consecutive steps or due times can no longer be told apart in f64.
+pub const MIN_RELATIVE_INTERVAL: f64 = 1e-12;
+
+/// Refuse an interval `dt` (s) that f64 cannot tell apart at times of size `scale` (s): below
+/// [`MIN_RELATIVE_INTERVAL`] of them, consecutive due times or steps round to the same time.
+/// `what` names the interval (with its value) in the message, `fix` says what to change.
+pub fn require_resolvable(
+    what: &str,
+    dt: f64,
+    scale: f64,
+    fix: &str,
+) -> crate::engine::error::Result<()> {
+    let floor = MIN_RELATIVE_INTERVAL * scale.abs();
+    if dt > 0.0 && dt >= floor {
+        return Ok(());
+    }
+    Err(invalid!(
+        "{what} cannot be resolved at t = {scale:e} s, so it cannot advance the time: f64 tells times apart only down to ~{floor:e} s there; {fix}"
+    ))
 }

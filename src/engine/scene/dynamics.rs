@@ -1,4 +1,4 @@
-//! What the models say about a scene's current state: tensions, rates, swimming velocities, and
+//! What the models say about a scene's current state: tensions and rates, and
 //! the right-hand side ([`OdeSystem`]) of the chosen model that every run and query uses.
 
 use super::*;
@@ -50,41 +50,12 @@ impl Scene {
         Ok((v, spin))
     }
 
-    /// Every swimmer's swimming velocity (m/s): dR_H/dt of the averaged model; in the sphere models,
-    /// whose centres oscillate within a stroke, R_H's displacement over the next period divided
-    /// by T (measured on a copy; the scene is not changed).
-    pub fn center_velocities(&self) -> Result<Vec<Vector3<f64>>> {
-        self.center_velocities_within(&never)
-    }
-
-    /// [`Scene::center_velocities`], its probe period stopped when `interrupted()` says so.
-    pub fn center_velocities_within(
-        &self,
-        interrupted: &dyn Fn() -> bool,
-    ) -> Result<Vec<Vector3<f64>>> {
-        let n = self.count();
-        if self.model == Model::Averaged {
-            let mut sys = self.system()?;
-            let mut dy = vec![0.0; self.state.len()];
-            sys.rhs(self.time, &self.state, &mut dy);
-            return Ok((0..n).map(|i| vec3(&dy, STATE_PER_SWIMMER * i)).collect());
-        }
-        let period = self.period()?;
-        let mut probe = self.clone();
-        probe
-            .run_periods(1.0, interrupted)
-            .map_err(|e| probe_error(e, self))?;
-        (0..n)
-            .map(|i| Ok((probe.displacement(i)? - self.displacement(i)?) / period))
-            .collect()
-    }
-
     /// The state vector (see [`super::model`]) and the base positions: for tests and savers.
     pub fn raw_state(&self) -> (&[f64], &[Vector3<f64>]) {
         (&self.state, &self.base)
     }
 
-    pub(super) fn system(&self) -> Result<Box<dyn OdeSystem>> {
+    pub(crate) fn system(&self) -> Result<Box<dyn OdeSystem>> {
         Ok(match self.model {
             Model::Micro => Box::new(MicroSystem::new(
                 &self.swimmers,
@@ -120,7 +91,7 @@ impl Scene {
     }
 
     /// The averaged equations describe identical strokes: ω, λ and ℓ must agree.
-    pub(super) fn check_averaged(&self) -> Result<()> {
+    pub(crate) fn check_averaged(&self) -> Result<()> {
         if let Some(first) = self.swimmers.first() {
             for (i, d) in self.swimmers.iter().enumerate() {
                 if d.omega != first.omega || d.lambda != first.lambda || d.ell != first.ell {

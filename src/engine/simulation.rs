@@ -1,0 +1,212 @@
+//! A [`Simulation`]: a [`Scene`] (state and settings) with what runs it: its recorders, the
+//! workspace its runs keep (stepper, device buffers), a second one for probe runs, and the run
+//! control (interrupt and progress) every run takes, probes included.
+//!
+//! A simulation reads as its scene (`Deref<Target = Scene>`: `sim.center(0)`, `sim.time()`);
+//! settings change through [`Simulation::scene_mut`].
+
+use super::advance::{advance_to, check_steps, Probe};
+use super::error::{invalid, require_finite, Result};
+use super::observable::Observable;
+use super::plan;
+use super::recorder::{Recorder, Trigger};
+use super::scene::Scene;
+use super::stepping::{Interrupt, Progress, RunControl, Workspace};
+use nalgebra::Vector3;
+
+/// A scene and what runs it. See the [module docs](self).
+#[derive(Debug, Default)]
+pub struct Simulation {
+    scene: Scene,
+    recorders: Vec<Recorder>,
+    workspace: Workspace,
+    probes: Workspace,
+    control: RunControl,
+}
+
+impl std::ops::Deref for Simulation {
+    type Target = Scene;
+    fn deref(&self) -> &Scene {
+        &self.scene
+    }
+}
+
+impl From<Scene> for Simulation {
+    fn from(scene: Scene) -> Self {
+        Simulation::new(scene)
+    }
+}
+
+impl Simulation {
+    /// A simulation of `scene`, with no recorders, never interrupted.
+    pub fn new(scene: Scene) -> Self {
+        Simulation {
+            scene,
+            ..Default::default()
+        }
+    }
+
+    /// The scene: state and settings.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Change the scene's settings or swimmers.
+    pub fn scene_mut(&mut self) -> &mut Scene {
+        &mut self.scene
+    }
+
+    /// Put `scene` in place of this simulation's scene, keeping the recorders and the run
+    /// control; returns the old scene.
+    pub fn replace_scene(&mut self, scene: Scene) -> Scene {
+        std::mem::replace(&mut self.scene, scene)
+    }
+
+    /// The scene, the rest dropped.
+    pub fn into_scene(self) -> Scene {
+        self.scene
+    }
+
+    /// The run control: how runs are stopped and whom they tell the time.
+    pub fn control(&self) -> &RunControl {
+        &self.control
+    }
+
+    /// Stop runs (and probes) at a step boundary when `interrupt()` says so (`None`: never).
+    pub fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
+        self.control.set_interrupt(interrupt);
+    }
+
+    /// Report progress to `p` during runs (`None`: no reports).
+    pub fn set_progress(&mut self, p: Option<Progress>) {
+        self.control.set_progress(p);
+    }
+
+    // ----- running -------------------------------------------------------------------------
+
+    /// Advance the scene by `duration` seconds. Equivalent to:
+    ///
+    /// ```text
+    /// t_end = time + duration
+    /// while time < t_end:
+    ///     if interrupted(): stop with Interrupted (state and time of the last step kept)
+    ///     take one step of the integrator towards t_end (never past it)
+    ///     if the new state has NaN/inf, overlapping spheres or a runaway spring:
+    ///         adaptive: retry with a smaller step; fixed-step: stop with StepFailed
+    ///         (swimmer, time, cause), keeping the last good state
+    ///     time = new time
+    ///     for each recorder due at this time (steps end exactly on due times): take a row
+    /// ```
+    /// Recorders also take a row at the end of the run if their trigger is "at end". Rows taken
+    /// before an error or interrupt are kept.
+    pub fn run(&mut self, duration: f64) -> Result<()> {
+        require_finite("duration", duration)?;
+        if duration < 0.0 {
+            return Err(invalid!(
+                "duration must be >= 0 s, got {duration}; the dynamics cannot run backwards"
+            ));
+        }
+        let t_end = self.scene.time() + duration;
+        self.check_run(t_end)?;
+        loop {
+            // Stop where a recorder wants a row, so nothing is evaluated between rows.
+            let now = self.scene.time();
+            let segment_end = self
+                .recorders
+                .iter()
+                .filter_map(|r| r.next_due(now))
+                .fold(t_end, f64::min)
+                .max(now);
+            advance_to(
+                &mut self.scene,
+                &mut self.workspace,
+                &self.control,
+                segment_end,
+            )?;
+            let end_of_run = self.scene.time() >= t_end;
+            self.fire_recorders(end_of_run)?;
+            if end_of_run {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Advance by `n` stroke periods (requires a common ω).
+    pub fn run_periods(&mut self, n: f64) -> Result<()> {
+        require_finite("periods", n)?;
+        if n < 0.0 {
+            return Err(invalid!("the number of periods must be >= 0, got {n}"));
+        }
+        let t = self.scene.period()?;
+        self.run(n * t)
+    }
+
+    /// What is refused before a run to `t_end` starts: a recorder the run cannot resolve or that
+    /// would take more rows than [`super::recorder::MAX_ROWS_PER_RUN`], and the integrator's own
+    /// refusals ([`check_steps`]).
+    fn check_run(&self, t_end: f64) -> Result<()> {
+        if t_end <= self.scene.time() {
+            return Ok(());
+        }
+        for r in &self.recorders {
+            r.check_run(self.scene.time(), t_end)?;
+        }
+        check_steps(&self.scene, t_end)
+    }
+
+    fn fire_recorders(&mut self, end_of_run: bool) -> Result<()> {
+        let mut probe = Probe::new(&mut self.probes, &self.control);
+        self.recorders
+            .iter_mut()
+            .try_for_each(|r| r.fire(&self.scene, end_of_run, &mut probe))
+    }
+
+    /// Which backend the next run uses and why (see [`plan::backend_info`]).
+    pub fn backend_info(&self) -> Result<String> {
+        plan::backend_info(&self.scene)
+    }
+
+    // ----- measuring and recording ---------------------------------------------------------
+
+    /// The value of `o` now; a probe (`delta_q`, ...) runs a copy a period ahead, stopped by the
+    /// run control's interrupt.
+    pub fn measure(&mut self, o: &Observable) -> Result<Vec<f64>> {
+        o.measure(
+            &self.scene,
+            &mut Probe::new(&mut self.probes, &self.control),
+        )
+    }
+
+    /// Every swimmer's swimming velocity (m/s); see [`Probe::center_velocities`].
+    pub fn center_velocities(&mut self) -> Result<Vec<Vector3<f64>>> {
+        Probe::new(&mut self.probes, &self.control).center_velocities(&self.scene)
+    }
+
+    /// Start recording `observables` on `trigger` (periodic triggers take their first row now);
+    /// returns the recorder's id.
+    pub fn record(&mut self, observables: Vec<Observable>, trigger: Trigger) -> Result<usize> {
+        let mut probe = Probe::new(&mut self.probes, &self.control);
+        let r = Recorder::start(&self.scene, observables, trigger, &mut probe)?;
+        Ok(self.add_recorder(r))
+    }
+
+    /// Attach a recorder made elsewhere; returns its id.
+    pub fn add_recorder(&mut self, r: Recorder) -> usize {
+        self.recorders.push(r);
+        self.recorders.len() - 1
+    }
+
+    /// A recorder by id.
+    pub fn recorder(&self, id: usize) -> Result<&Recorder> {
+        self.recorders
+            .get(id)
+            .ok_or_else(|| invalid!("recorder {id} does not belong to this scene"))
+    }
+
+    /// A recorder by id, to change (e.g. to stream its rows).
+    pub fn recorder_mut(&mut self, id: usize) -> Result<&mut Recorder> {
+        self.recorders
+            .get_mut(id)
+            .ok_or_else(|| invalid!("recorder {id} does not belong to this scene"))
+    }
+}

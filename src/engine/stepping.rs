@@ -1,0 +1,233 @@
+//! Stepping a scene towards a time on one backend: the run control every run takes (interrupt and
+//! progress), the workspace a run keeps between runs (the stepper, the device buffers), the CPU
+//! stepper with its guards, and the GPU run with a CPU replay of a failing step.
+//!
+//! Which backend a run takes is decided above this module ([`super::plan`], [`super::advance`]):
+//! the calibration of "auto" steps both backends through here.
+
+use super::backend;
+use super::error::{invalid, unsupported, EngineError, Result, Setting};
+use super::gpu::{GpuModel, GpuRun, RunOutcome, UniformSteps};
+use super::integrators::{uniform_steps, IntegratorSpec, Stepper};
+use super::model::Model;
+use super::scene::Scene;
+use std::sync::Arc;
+
+/// Asked at every step boundary whether the run should stop (e.g. after Ctrl-C). It must be cheap.
+pub type Interrupt = Arc<dyn Fn() -> bool + Send + Sync>;
+
+/// A run's progress report: called with the scene time after every CPU step and after every
+/// device run segment, e.g. to draw a progress bar. It must be cheap.
+pub type Progress = Arc<dyn Fn(f64) + Send + Sync>;
+
+/// What every run takes besides the scene: whether to stop, and whom to tell the time. The
+/// default never stops and tells no one.
+#[derive(Clone, Default)]
+pub struct RunControl {
+    interrupt: Option<Interrupt>,
+    progress: Option<Progress>,
+}
+
+impl std::fmt::Debug for RunControl {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunControl")
+            .field("interrupt", &self.interrupt.is_some())
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
+}
+
+impl RunControl {
+    /// A control that stops a run when `interrupt()` says so.
+    pub fn interruptible(interrupt: Interrupt) -> Self {
+        RunControl {
+            interrupt: Some(interrupt),
+            progress: None,
+        }
+    }
+
+    /// Stop runs when `interrupt()` says so (`None`: never).
+    pub fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
+        self.interrupt = interrupt;
+    }
+
+    /// Report progress to `p` (`None`: no reports).
+    pub fn set_progress(&mut self, p: Option<Progress>) {
+        self.progress = p;
+    }
+
+    /// Whether the run should stop now.
+    pub fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(|f| f())
+    }
+
+    /// Tell the progress report the scene time.
+    pub fn report(&self, time: f64) {
+        if let Some(p) = &self.progress {
+            p(time);
+        }
+    }
+
+    /// The control of a probe run on a copy: the same interrupt, no progress (the copy's time is
+    /// not the run's).
+    pub fn for_probe(&self) -> Self {
+        RunControl {
+            interrupt: self.interrupt.clone(),
+            progress: None,
+        }
+    }
+}
+
+/// What a run keeps for the next one: the stepper (an adaptive one remembers its step size) and
+/// the device buffers of the last GPU run, reused while the scene's size and method stay.
+#[derive(Default)]
+pub struct Workspace {
+    stepper: Option<(IntegratorSpec, Box<dyn Stepper>)>,
+    gpu: Option<GpuRun>,
+}
+
+impl std::fmt::Debug for Workspace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Workspace")
+            .field("stepper", &self.stepper.as_ref().map(|(spec, _)| spec))
+            .field("gpu", &self.gpu.is_some())
+            .finish()
+    }
+}
+
+impl Workspace {
+    /// Forget the stepper, so the next run starts as a fresh one does (device buffers are kept:
+    /// they hold no state between runs).
+    pub fn forget_stepper(&mut self) {
+        self.stepper = None;
+    }
+}
+
+/// Step `s` to `t_end` on the CPU with the guards, taking at most `max_steps` steps.
+pub fn advance_cpu(
+    s: &mut Scene,
+    ws: &mut Workspace,
+    control: &RunControl,
+    t_end: f64,
+    max_steps: u64,
+) -> Result<()> {
+    let mut sys = s.system()?;
+    let spec = s.integrator();
+    let mut stepper = match ws.stepper.take() {
+        Some((cached, mut st)) if cached == spec => {
+            st.reset();
+            st
+        }
+        _ => spec.build(),
+    };
+    let mut outcome = Ok(());
+    let mut taken = 0;
+    while s.time < t_end && taken < max_steps {
+        taken += 1;
+        if control.interrupted() {
+            outcome = Err(EngineError::Interrupted { time: s.time });
+            break;
+        }
+        match stepper.step(sys.as_mut(), s.time, &mut s.state, t_end, &mut s.stats) {
+            Ok(t) => {
+                s.time = t;
+                control.report(s.time);
+            }
+            Err(f) => {
+                outcome = Err(EngineError::StepFailed {
+                    time: f.time,
+                    last_good: s.time,
+                    swimmer: f.problem.swimmer,
+                    cause: f.problem.cause,
+                    hint: f.problem.hint,
+                    fixes: f.problem.fixes,
+                });
+                break;
+            }
+        }
+    }
+    ws.stepper = Some((spec, stepper));
+    outcome
+}
+
+/// Step `s` to `t_end` on the GPU: uniform steps as the CPU stepper takes them. A step whose
+/// state fails a guard on the device is replayed on the CPU, which either reports it exactly as
+/// the CPU backend does or (a borderline case decided differently by rounding) takes it.
+pub fn advance_gpu(
+    s: &mut Scene,
+    ws: &mut Workspace,
+    control: &RunControl,
+    t_end: f64,
+) -> Result<()> {
+    let (dt, tableau) = backend::gpu_tableau(&s.integrator()).map_err(|e| invalid!("{e}"))?;
+    let model = match s.model() {
+        Model::Micro => GpuModel::Micro {
+            mu: s.mu(),
+            mobility: s.mobility(),
+        },
+        Model::Averaged => {
+            s.check_averaged()?;
+            GpuModel::Averaged {
+                coefficients: s.coefficients(),
+            }
+        }
+        Model::Rigid => return Err(invalid!("the rigid-stroke model runs on the CPU only")),
+    };
+    let mut run = match ws.gpu.take() {
+        Some(r) if r.fits(model, s.count(), &tableau) => r,
+        _ => GpuRun::new(model, s.count(), tableau.clone()).map_err(|e| invalid!("{e}"))?,
+    };
+    let stages = tableau.stages() as u64;
+    let interrupted = || control.interrupted();
+    let result = loop {
+        if s.time >= t_end {
+            break Ok(());
+        }
+        let (n, h) = uniform_steps(s.time, t_end, dt);
+        let t0 = s.time;
+        let outcome = run.run(
+            &s.swimmers,
+            &s.base,
+            &mut s.state,
+            UniformSteps { t0, h, count: n },
+            &interrupted,
+        );
+        let done = match outcome {
+            Err(e) => {
+                break Err(unsupported(
+                    format!(
+                        "the GPU run failed: {e}; the scene keeps its state at t = {:.6e} s",
+                        s.time
+                    ),
+                    &[Setting::Backend("cpu")],
+                ))
+            }
+            Ok(RunOutcome::Done) => n,
+            Ok(RunOutcome::Failed { steps_done }) | Ok(RunOutcome::Interrupted { steps_done }) => {
+                steps_done
+            }
+        };
+        s.time = if done == n {
+            t_end
+        } else {
+            t0 + done as f64 * h
+        };
+        s.stats.steps += done;
+        s.stats.rhs_evals += done * stages + 1;
+        control.report(s.time);
+        match outcome {
+            Ok(RunOutcome::Interrupted { .. }) => {
+                break Err(EngineError::Interrupted { time: s.time })
+            }
+            Ok(RunOutcome::Failed { .. }) => {
+                // One step on the CPU: the same step, checked by the same guards.
+                if let Err(e) = advance_cpu(s, ws, control, t_end, 1) {
+                    break Err(e);
+                }
+            }
+            _ => {}
+        }
+    };
+    ws.gpu = Some(run);
+    result
+}
