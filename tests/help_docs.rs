@@ -6,7 +6,7 @@ use swimlab::script::{docs::DOCS, engine, run_source};
 
 #[test]
 fn every_help_example_runs() {
-    for d in DOCS {
+    for d in DOCS.iter() {
         run_source(&format!(":help {}", d.name), d.example, &mut Scope::new())
             .unwrap_or_else(|e| panic!("example of {} fails:\n{e}", d.name));
     }

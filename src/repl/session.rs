@@ -242,7 +242,7 @@ fn incomplete(input: &str, err: &ParseErrorType, pos: rhai::Position) -> bool {
 fn help_overview() -> String {
     let mut out = String::from("swimlab: scenes of dumbbell swimmers. :help NAME for one name.\n");
     let mut groups: Vec<&str> = Vec::new();
-    for d in docs::DOCS {
+    for d in docs::DOCS.iter() {
         if !groups.contains(&d.group) {
             groups.push(d.group);
         }

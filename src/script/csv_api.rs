@@ -1,6 +1,7 @@
 //! `write_csv(path, rows)` / `write_csv(path, columns, rows)`: tables from scripts.
 
 use super::convert::{script_error, ScriptResult};
+use super::docs::{doc_entry, Doc};
 use crate::engine::files::write_atomically;
 use rhai::{Array, Dynamic, Engine, Map};
 use std::path::Path;
@@ -74,3 +75,12 @@ pub fn register(engine: &mut Engine) {
             write_table(path, &cols, &rows)
         });
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[doc_entry!(
+    "write_csv",
+    "files",
+    "write_csv(path, rows)\nwrite_csv(path, columns, rows)",
+    "Write an array of maps as CSV (columns in the given order, or sorted).",
+    "write_csv(\"out/help/t.csv\", [\"D\", \"v\"], [#{ D: 10.0, v: 1e-6 }]);"
+)];

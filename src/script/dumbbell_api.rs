@@ -1,6 +1,7 @@
 //! `dumbbell(#{...})`: a swimmer's parameters and pose, before it is added to a scene.
 
 use super::convert::{array3, number, script_error, unknown_choice, vector3, ScriptResult};
+use super::docs::{doc_entry, Doc};
 use crate::engine::swimmer::unit_direction;
 use crate::engine::Dumbbell;
 use nalgebra::Vector3;
@@ -100,3 +101,15 @@ pub fn register(engine: &mut Engine) {
         .register_get("center", |d: &mut DumbbellSpec| array3(&d.center))
         .register_get("dir", |d: &mut DumbbellSpec| array3(&d.dir));
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("dumbbell", "building", "dumbbell() -> Dumbbell\ndumbbell(#{ a1, a2, ell, lambda, omega, k0, phase, center, dir }) -> Dumbbell", "A swimmer description (SI units). Every key is optional; defaults are the paper's symmetric Fig-1 swimmer (a1 = a2 = 0.15 ell, ell = 5e-6 m, lambda = 0.1 ell, omega = 500 1/s, k0 = 1e-3 kg/s^2, phase 0, at the origin, along +x). Unknown keys are errors.", "let d = dumbbell(#{ a1: 1.125e-6, a2: 0.5625e-6, phase: 0.5 }); print(d.a2);"),
+    doc_entry!("phase_deg", "phases", "phase_deg(x) -> float", "x degrees as radians in [0, 2 pi).", "print(phase_deg(90));"),
+    doc_entry!("a1", "swimmer properties", "d.a1 -> float", "Radius of sphere 1 (m); N points from it to sphere 2.", "print(dumbbell().a1);"),
+    doc_entry!("a2", "swimmer properties", "d.a2 -> float", "Radius of sphere 2 (m).", "print(dumbbell(#{ a2: 1e-6 }).a2);"),
+    doc_entry!("ell", "swimmer properties", "d.ell -> float", "Mean length (m).", "print(dumbbell().ell);"),
+    doc_entry!("lambda", "swimmer properties", "d.lambda -> float", "Stroke amplitude (m).", "print(dumbbell().lambda);"),
+    doc_entry!("omega", "swimmer properties", "d.omega -> float", "Angular frequency (1/s).", "print(dumbbell().omega);"),
+    doc_entry!("k0", "swimmer properties", "d.k0 -> float", "Spring constant (kg/s^2).", "print(dumbbell().k0);"),
+];

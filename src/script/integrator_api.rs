@@ -2,6 +2,7 @@
 //! `Integrator`), one constructor per entry of the engine's method table.
 
 use super::convert::{lift, number, ScriptResult};
+use super::docs::{doc_entry, Doc};
 use crate::engine::integrators::METHODS;
 use crate::engine::IntegratorSpec;
 use rhai::{Dynamic, Engine};
@@ -28,3 +29,11 @@ pub fn register(engine: &mut Engine) {
     super::convert::register_display::<IntegratorSpec>(engine);
     engine.register_fn("==", |a: IntegratorSpec, b: IntegratorSpec| a == b);
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("euler", "numerics", "euler(dt) -> Integrator", "Forward Euler with steps of at most dt seconds.", "let i = euler(1e-6); print(i);"),
+    doc_entry!("rk4", "numerics", "rk4(dt) -> Integrator", "Classic Runge-Kutta 4 with steps of at most dt seconds.", "let i = rk4(5e-6); print(i);"),
+    doc_entry!("dopri5", "numerics", "dopri5(rtol) -> Integrator", "Adaptive Dormand-Prince 5(4); rtol is relative to the stroke and drift scales, not to positions.", "let i = dopri5(1e-8); print(i);"),
+    doc_entry!("rosw", "numerics", "rosw(rtol) -> Integrator", "Adaptive Rosenbrock-W ROS34PW2 (order 3, L-stable): implicit in each dumbbell's own spring and hydrodynamics, explicit between dumbbells; not held by the spring's stability limit.", "let i = rosw(1e-6); print(i);"),
+];

@@ -2,6 +2,7 @@
 //! and recorders (type `Recorder`): `s.record([...], trigger)`, `.rows`, `.to_csv(path)`.
 
 use super::convert::{index, lift, number, register_display, script_error, vector3, ScriptResult};
+use super::docs::{self, doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::{Observable, Recorder, Trigger};
 use nalgebra::Vector3;
@@ -267,3 +268,37 @@ pub fn register(engine: &mut Engine) {
             },
         );
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("observe", "observables", "s.observe(obs) -> float | array", "Evaluate an observable now.", "let s = scene(); s.add(dumbbell()); print(s.observe(R_H(0)));"),
+    doc_entry!("R_H", "observables", "R_H(i) -> Observable", "Hydrodynamic centre of swimmer i (m).", "print(R_H(0));"),
+    doc_entry!("R_G", "observables", "R_G(i) -> Observable", "Geometric centre (X1 + X2)/2 of swimmer i (m).", "print(R_G(0));"),
+    doc_entry!("N", "observables", "N(i) -> Observable", "Unit orientation of swimmer i.", "print(N(0));"),
+    doc_entry!("tension", "observables", "tension(i) -> Observable", "Spring tension k0 (d - L) of swimmer i (N), microscopic model.", "print(tension(0));"),
+    doc_entry!("pair_mean", "observables", "pair_mean(i, j) -> Observable\npair_mean(i, j, axis) -> Observable", "(R_H^i + R_H^j)/2 along axis (default x) (m).", "print(pair_mean(0, 1, [0, 0, 1]));"),
+    doc_entry!("pair_separation", "observables", "pair_separation(i, j) -> Observable\npair_separation(i, j, axis) -> Observable", "R_H^j - R_H^i along axis (default x) (m).", "print(pair_separation(0, 1));"),
+    doc_entry!("q", "observables", "q(i, j) -> Observable", "q = N^i . N^j.", "print(q(0, 1));"),
+    doc_entry!("D_H", "observables", "D_H(i, j) -> Observable", "Distance |R_H^i - R_H^j| (m).", "print(D_H(0, 1));"),
+    doc_entry!("delta_q", "observables", "delta_q(i, j) -> Observable", "q(0) - q(T) over the next period, measured on a copy (the scene is not advanced).", docs::PAIR_DELTA_Q),
+    doc_entry!("delta_D_H", "observables", "delta_D_H(i, j) -> Observable", "[D_H(0) - D_H(T)]/ell over the next period, on a copy; > 0: approaching.", "print(delta_D_H(0, 1));"),
+    doc_entry!("mean_speed", "observables", "mean_speed() -> Observable", "Mean swimming speed <|V|> over the swimmers (m/s). Averaged model: V = dR_H/dt. Sphere models: the displacement of R_H over the next period divided by T, measured on a copy of the scene (costs one period per evaluation).", "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [20e-6, 0, 0], phase: 1.0 })); s.model = \"averaged\"; print(s.observe(mean_speed()));"),
+    doc_entry!("pair_distances", "observables", "pair_distances(bins, r_max) -> Observable", "Histogram of the hydrodynamic-centre distances D_H of all pairs: an array of bins counts, bin k covering [k, k+1) * r_max / bins (m); pairs at r_max or beyond are not counted. Recorded as columns D_H_hist[0], D_H_hist[1], ...", "let s = scene(); s.add_random(dumbbell(#{}), 30, 0.01, 2); print(s.observe(pair_distances(10, 100e-6)));"),
+    doc_entry!("polarization", "observables", "polarization() -> Observable", "|<N>| over all swimmers.", "let s = scene(); s.add(dumbbell()); print(s.observe(polarization()));"),
+    doc_entry!("min_gap", "observables", "min_gap() -> Observable", "The smallest gap between the surfaces of any two spheres of the scene (m): how close the closest approach is. O(N²), parallel for large scenes.", "let s = scene(); s.add(dumbbell(#{})); s.add(dumbbell(#{ center: [2e-5, 0.0, 0.0] })); print(s.observe(min_gap()));"),
+    doc_entry!("nematic", "observables", "nematic() -> Observable", "Largest eigenvalue of Q = <3NN - I>/2.", "let s = scene(); s.add(dumbbell()); print(s.observe(nematic()));"),
+    doc_entry!("record", "recording", "s.record([obs, ...], every) -> Recorder", "Record observables on a trigger: a number (every n periods), every_periods(n), every_seconds(t), at_times([..]) or at_end(). Periodic recorders take a row at once. Only the recorded observables are evaluated, only at their times.", docs::PAIR_RECORD),
+    doc_entry!("every_periods", "recording", "every_periods(n) -> Trigger", "Every n periods from now.", "print(every_periods(2));"),
+    doc_entry!("every_seconds", "recording", "every_seconds(t) -> Trigger", "Every t seconds from now.", "print(every_seconds(1e-3));"),
+    doc_entry!("at_times", "recording", "at_times([t1, t2, ...]) -> Trigger", "At the given absolute times (s).", "print(at_times([0.01, 0.02]));"),
+    doc_entry!("at_end", "recording", "at_end() -> Trigger", "At the end of every run.", "print(at_end());"),
+    doc_entry!("rows", "recording", "rec.rows -> array of maps", "The recorded rows, keyed by column name (time, R_H[0].x, ...).", docs::PAIR_ROWS),
+    doc_entry!("columns", "recording", "rec.columns -> array\nrec.header -> array\nrec.column(name) -> array", "Column names (without / with units) and one column's values.", docs::PAIR_COLUMNS),
+    doc_entry!("stream_csv", "recording", "rec.stream_csv(path)", "From now on append every row to path as CSV the moment it is recorded (one whole line per row, unbuffered; the file starts with the header and the rows so far). A kill or Ctrl-C loses no row already recorded.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); r.stream_csv(\"out/help/stream.csv\"); s.run_periods(2);"),
+    doc_entry!("to_csv", "recording", "rec.to_csv(path)", "Write the rows as CSV; the header carries names and units. Folders are created; the file is written whole to a temporary file and renamed, so a crash keeps the old one.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); s.run_periods(1); r.to_csv(\"out/help/r.csv\");"),
+    doc_entry!("name", "observables", "obs.name -> string\nobs.unit -> string", "An observable's name (its column prefix) and unit.", "print(q(0, 1).name); print(R_H(0).unit);"),
+    doc_entry!("unit", "observables", "obs.unit -> string", "An observable's unit (m, N, ell, or 1).", "print(D_H(0, 1).unit);"),
+    doc_entry!("len", "recording", "rec.len -> int", "Number of rows recorded.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); s.run_periods(2); print(r.len);"),
+    doc_entry!("header", "recording", "rec.header -> array", "Column names with units, as written to CSV.", docs::PAIR_COLUMNS),
+    doc_entry!("column", "recording", "rec.column(name) -> array", "One column's values.", docs::PAIR_COLUMNS),
+];

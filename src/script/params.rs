@@ -6,6 +6,7 @@
 //! silently), and so is a `let NAME = ...` or `const NAME = ...` that would shadow the value
 //! without reading it (write `let NAME = param("NAME", default);` instead).
 
+use super::docs::{doc_entry, Doc};
 use rhai::{Dynamic, Engine, Position, AST};
 
 /// The `--set` values of one run, in command-line order.
@@ -163,3 +164,8 @@ pub fn check(ast: &AST, sets: &Sets) -> Result<(), (Position, String)> {
     }
     Ok(())
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("param", "running", "param(name, default) -> value", "The value given by swimlab run --set name=VALUE, or default without one: let D = param(\"D\", 10.0); lets a cluster job choose D. A --set name the script never reads, or hides with its own let, is an error.", "let D = param(\"D\", 10.0); print(D);"),
+];

@@ -6,6 +6,7 @@
 //! map `#{ title, x_label, y_label, log_x, log_y, width, height }` (and `cols`, `rows` for text).
 
 use super::convert::{number, script_error, ScriptResult};
+use super::docs::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
 use super::scene_api::SceneHandle;
 use crate::plot::{render_text, snapshot, Figure, Legend, Plane, Series, SnapshotOptions, Style};
@@ -309,3 +310,10 @@ pub fn register(engine: &mut Engine) {
             },
         );
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("plot", "pictures", "plot(path, series)\nplot(path, series, #{ title, x_label, y_label, log_x, log_y, width, height })\nrec.plot(path, x_column, y_columns)\nrec.plot(path, x_column, y_columns, options)", "Draw series to an SVG or PNG file (by the extension; folders are created). A series is #{ x: [..], y: [..], label: \"..\", style: \"line\" | \"points\" }; give one map or an array of them. rec.plot draws recorded columns against one column, with their units as labels. Text uses an embedded font: no system fonts needed.", "plot(\"out/help/p.svg\", [#{ x: [1, 2, 3], y: [1, 4, 9], label: \"x^2\" }, #{ x: [1, 2, 3], y: [1, 8, 27], label: \"x^3\", style: \"points\" }], #{ title: \"powers\", x_label: \"x\", y_label: \"y\", log_y: true });"),
+    doc_entry!("tplot", "pictures", "tplot(series)\ntplot(series, options)\nrec.tplot(x_column, y_columns)\nrec.tplot(x_column, y_columns, options)", "A quick plot as text in the terminal: series and options as for plot, plus cols and rows (the plot area in characters, default 72 x 18).", "tplot(#{ x: [0, 1, 2, 3], y: [0, 1, 4, 9], label: \"x^2\" }, #{ cols: 40, rows: 8 });"),
+    doc_entry!("snapshot", "pictures", "s.snapshot(path)\ns.snapshot(path, #{ plane: \"xy\" | \"xz\" | \"yz\", title, width, height })", "A picture of the scene (SVG or PNG): every swimmer's spheres at their radii and its rod, projected on a plane, coloured by the in-plane direction of N (aligned swimmers share a colour; out-of-plane ones fade to grey). Call it in a loop for the frames of an animation.", "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [12e-6, 3e-6, 0], dir: [0, 1, 0] })); s.snapshot(\"out/help/scene.png\", #{ title: \"two swimmers\" });"),
+];

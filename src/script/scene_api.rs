@@ -6,6 +6,7 @@
 //! ([`interrupt`]).
 
 use super::convert::{array3, index, lift, number, script_error, ScriptResult};
+use super::docs::{self, doc_entry, Doc};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
 use crate::engine::{Backend, Scene, Simulation};
@@ -393,3 +394,26 @@ pub fn register(engine: &mut Engine) {
             m
         });
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("scene", "building", "scene() -> Scene", "An empty scene: no swimmers, mu = 1e-3 Pa s, model \"micro\", mobility \"rpy\", default integrator.", "let s = scene(); print(s);"),
+    doc_entry!("add", "building", "s.add(d: Dumbbell) -> int", "Add a swimmer at length L(t) of the scene's time, its hydrodynamic centre at d.center, pointing along d.dir; returns its 0-based index. Refuses overlapping swimmers.", "let s = scene(); let i = s.add(dumbbell()); print(i);"),
+    doc_entry!("copy", "building", "s.copy() -> Scene", "An independent copy of the scene (same state, no recorders). `let t = s;` would name the same scene.", "let s = scene(); let t = s.copy(); t.add(dumbbell()); print(s.count);"),
+    doc_entry!("phase", "phases", "phase(x) -> float\ns.phase(i) -> float", "phase(x): x radians wrapped to [0, 2 pi). s.phase(i): the stroke phase of swimmer i.", "print(phase(7.0)); let s = scene(); s.add(dumbbell(#{ phase: 1.0 })); print(s.phase(0));"),
+    doc_entry!("phases", "phases", "s.phases -> array\ns.phases = [..]", "All stroke phases (rad) in swimmer order; assign one per swimmer.", docs::PAIR_PHASES),
+    doc_entry!("set_phase", "phases", "s.set_phase(i, phi)", "Set the stroke phase of swimmer i (rad).", "let s = scene(); s.add(dumbbell()); s.set_phase(0, pi()); print(s.phases);"),
+    doc_entry!("add_random", "scene", "s.add_random(d, n, volume_fraction, seed) -> int\ns.add_random(d, n, volume_fraction, seed, #{ aligned: [x, y, z], phase: p }) -> int", "Add n copies of dumbbell d at random places in a cube centred on the origin, sized so that all spheres fill the given volume fraction, without overlaps (random sequential addition, seeded: the same seed gives the same scene). Orientations and phases are random unless fixed by the options. Returns the new swimmer count; on failure the scene is unchanged.", "let s = scene(); s.add_random(dumbbell(#{}), 20, 0.01, 1); print(s.count);"),
+    doc_entry!("add_at", "scene", "s.add_at(d, centres: array) -> int", "Add a copy of dumbbell d (its orientation and phase) at every centre [x, y, z] (m) of the array, e.g. a lattice from the stdlib module \"lattice\". All or nothing: if one does not fit, the scene is unchanged. Returns the new swimmer count.", "import \"lattice\" as lattice; let s = scene(); s.add_at(dumbbell(), lattice::cubic(2, 2, 2, 20e-6)); print(s.count);"),
+    doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
+    doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
+    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations.", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
+    doc_entry!("center", "reading", "s.center(i) -> [x, y, z]", "Hydrodynamic centre R_H of swimmer i (m).", "let s = scene(); s.add(dumbbell()); print(s.center(0));"),
+    doc_entry!("dir", "reading", "s.dir(i) -> [x, y, z]", "Unit orientation N of swimmer i (from the a1 sphere to the a2 sphere).", "let s = scene(); s.add(dumbbell(#{ dir: [0, 1, 0] })); print(s.dir(0));"),
+    doc_entry!("velocity", "reading", "s.velocity(i) -> [x, y, z]", "dR_H/dt of swimmer i now (m/s).", docs::PAIR_VELOCITY),
+    doc_entry!("spin", "reading", "s.spin(i) -> [x, y, z]", "dN/dt of swimmer i now (1/s).", "let s = scene(); s.add(dumbbell()); print(s.spin(0));"),
+    doc_entry!("length", "reading", "s.length(i) -> float\nlength(i) -> Observable", "Length |X2 - X1| of swimmer i (m); as a global function, the observable.", "let s = scene(); s.add(dumbbell()); print(s.length(0)); print(length(0));"),
+    doc_entry!("swimmer", "reading", "s.swimmer(i) -> Dumbbell", "Parameters and current pose of swimmer i.", "let s = scene(); s.add(dumbbell()); print(s.swimmer(0));"),
+    doc_entry!("save", "files", "s.save(path)", "Save the whole scene (swimmers, phases, model, integrator, time, state) as JSON; load_scene reads it back exactly. Recorders are not saved; an adaptive integrator restarts its step-size control after loading.", "let s = scene(); s.add(dumbbell()); s.save(\"out/help/scene.json\"); let t = load_scene(\"out/help/scene.json\"); print(t.count);"),
+    doc_entry!("load_scene", "files", "load_scene(path) -> Scene", "A scene saved with s.save(path).", "let s = scene(); s.save(\"out/help/empty.json\"); print(load_scene(\"out/help/empty.json\"));"),
+];

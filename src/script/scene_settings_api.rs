@@ -3,6 +3,7 @@
 //! `s.integrator`, and the read-only `time`, `count`, `period`, `stiff_rate`, `backend_info`.
 
 use super::convert::{lift, number, script_error, unknown_choice, ScriptResult};
+use super::docs::{doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::choice::{self, Named};
 use crate::engine::integrators::METHODS;
@@ -185,3 +186,21 @@ pub fn register(engine: &mut Engine) {
             },
         );
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("model", "numerics", "s.model -> string\ns.model = \"micro\" | \"rigid\" | \"averaged\"", "The model: \"micro\" (spheres, springs, mobility), \"rigid\" (the same with lengths following L(t) exactly: k0 -> infinity, not stiff) or \"averaged\" (stroke-averaged R_H and N). Switching converts the state.", "let s = scene(); s.add(dumbbell()); s.model = \"averaged\"; print(s.model);"),
+    doc_entry!("backend", "numerics", "s.backend -> string\ns.backend = \"cpu\" | \"gpu\" | \"auto\"", "Where the dynamics run: the CPU (default), a GPU through wgpu (Vulkan, Metal, DX12; f64 shaders required; fixed-step euler/rk4, micro and averaged models), or \"auto\": the GPU when one is present and the scene is at least as large as the crossover measured on this machine. Results agree to round-off (tested to 1e-12 per step).", "let s = scene(); s.backend = \"auto\"; print(s.backend);"),
+    doc_entry!("backend_info", "numerics", "s.backend_info -> string", "Which backend the next run uses and why (for \"auto\": the measured crossover).", "let s = scene(); print(s.backend_info);"),
+    doc_entry!("mobility", "numerics", "s.mobility -> string\ns.mobility = \"rpy\" | \"oseen\"", "Pair mobility of the microscopic model: Rotne-Prager-Yamakawa (default) or Oseen.", "let s = scene(); s.mobility = \"oseen\"; print(s.mobility);"),
+    doc_entry!("overlaps", "numerics", "s.overlaps -> string\ns.overlaps = \"stop\" | \"allow\"", "What happens when spheres of different swimmers touch: \"stop\" (default) ends the run with an error naming them; \"allow\" lets them overlap, moved by the RPY tensor for overlapping spheres (Zuk et al. 2014, positive definite; the averaged model, a far-field model, then runs on with its D^-5 terms). A swimmer's own spheres touching always stops the run. CPU only.", "let s = scene(); s.overlaps = \"allow\"; print(s.overlaps);"),
+    doc_entry!("steric", "numerics", "s.steric -> map or ()\ns.steric = #{ range, stiffness } | ()", "A soft repulsion between spheres of different swimmers: force stiffness * (range - gap) (N) along the line of centres when their surface gap is below range (m). Off by default (). Microscopic model: the forces join the spring forces in the mobility. Averaged model: each swimmer moves as a free-draining rigid dumbbell of length ell under them. Not in the rigid-stroke model; CPU only; costs one O(N^2) pass per right-hand side.", "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3 }; print(s.steric.range);"),
+    doc_entry!("cutoff", "numerics", "s.cutoff -> float or ()\ns.cutoff = distance | ()", "Far-field cutoff of the averaged model (m): pairs further apart are left out. Off by default (). Each left-out pair's contribution is bounded by 9/64 v0 (28|A_R|(Lambda/ell) xi^3 + 84 c_J xi^4) with xi = ell/cutoff (README, Suspensions).", "let s = scene(); s.cutoff = 100e-6; print(s.cutoff);"),
+    doc_entry!("coefficients", "numerics", "s.coefficients -> string\ns.coefficients = \"paper\" | \"leading_order\"", "Coefficients of the averaged model's I and J terms: as published, or the leading-order ones.", "let s = scene(); s.coefficients = \"leading_order\"; print(s.coefficients);"),
+    doc_entry!("integrator", "numerics", "s.integrator -> Integrator\ns.integrator = euler(dt) | rk4(dt) | dopri5(rtol) | rosw(rtol) | \"default\"", "The time integrator. The default depends on the model and the scene's stiffness.", "let s = scene(); s.add(dumbbell()); print(s.integrator); s.integrator = rk4(5e-6); print(s.integrator);"),
+    doc_entry!("mu", "numerics", "s.mu -> float\ns.mu = x", "Viscosity (Pa s).", "let s = scene(); s.mu = 2e-3; print(s.mu);"),
+    doc_entry!("stiff_rate", "numerics", "s.stiff_rate -> float", "The largest spring relaxation rate k0 (1/gamma1 + 1/gamma2) (1/s); explicit steps need dt below ~2.8/rate.", "let s = scene(); s.add(dumbbell()); print(s.stiff_rate);"),
+    doc_entry!("time", "running", "s.time -> float", "Current time (s).", "let s = scene(); print(s.time);"),
+    doc_entry!("period", "running", "s.period -> float", "The common stroke period (s).", "let s = scene(); s.add(dumbbell()); print(s.period);"),
+    doc_entry!("count", "running", "s.count -> int", "Number of swimmers.", "let s = scene(); print(s.count);"),
+];

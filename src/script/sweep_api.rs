@@ -5,6 +5,7 @@
 //! is the error, naming its parameter. Ctrl-C stops every call between statements.
 
 use super::convert::{script_error, ScriptResult};
+use super::docs::{doc_entry, Doc};
 use rayon::prelude::*;
 use rhai::{Array, Dynamic, Engine, EvalAltResult, FnPtr, NativeCallContext, INT};
 
@@ -87,3 +88,8 @@ pub fn register(engine: &mut Engine) {
             },
         );
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!("sweep", "scene", "sweep(params: array, f) -> array\nsweep(params: array, f, threads: int) -> array", "Call f(p) for every p of params on all cores (or on `threads` threads) and return the results in the order of params. Each call should build its own scene; results may be numbers, strings, arrays or maps. The first failing call is the error, naming its parameter. For clusters, run one process per parameter instead: swimlab run script.rhai --set D=10 (README, Sweeps).", "let r = sweep([1, 2, 3], |p| p * p); print(r);"),
+];

@@ -1,6 +1,7 @@
 //! Small helpers scripts need: number formatting, `pi()`, and the quick mode of long scripts.
 
 use super::convert::{number, ScriptResult};
+use super::docs::{doc_entry, Doc};
 use super::limits;
 use rhai::{Dynamic, Engine, INT};
 
@@ -68,3 +69,63 @@ pub fn register(engine: &mut Engine) {
         .register_fn("rpad", |x: Dynamic, width: INT| pad(&x, width, true))
         .register_fn("is_number", |x: Dynamic| x.is_float() || x.is_int());
 }
+
+/// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
+pub(super) const DOCS: &[Doc] = &[
+    doc_entry!(
+        "sci",
+        "formatting",
+        "sci(x) -> string\nsci(x, digits) -> string",
+        "Scientific notation.",
+        "print(sci(1.23456e-7, 2));"
+    ),
+    doc_entry!(
+        "fixed",
+        "formatting",
+        "fixed(x, digits) -> string",
+        "Fixed-point notation.",
+        "print(fixed(3.14159, 2));"
+    ),
+    doc_entry!(
+        "lpad",
+        "formatting",
+        "lpad(x, width) -> string",
+        "Right-align x in width characters.",
+        "print(lpad(42, 6));"
+    ),
+    doc_entry!(
+        "rpad",
+        "formatting",
+        "rpad(x, width) -> string",
+        "Left-align x in width characters.",
+        "print(rpad(\"D\", 6) + \"|\");"
+    ),
+    doc_entry!(
+        "pi",
+        "formatting",
+        "pi() -> float",
+        "The number pi.",
+        "print(pi());"
+    ),
+    doc_entry!(
+        "quick",
+        "formatting",
+        "quick() -> bool",
+        "True under `swimlab run --quick` (or SWIMLAB_QUICK=1): long scripts run a short variant.",
+        "let n = if quick() { 1 } else { 100 }; print(n);"
+    ),
+    doc_entry!(
+        "is_number",
+        "formatting",
+        "is_number(x) -> bool",
+        "Whether x is an integer or a float.",
+        "print(is_number(1e-6));"
+    ),
+    doc_entry!(
+        "uniform_randoms",
+        "formatting",
+        "uniform_randoms(n, seed) -> array",
+        "n reproducible uniform numbers in [0, 1) (splitmix64).",
+        "print(uniform_randoms(3, 42));"
+    ),
+];
