@@ -34,6 +34,23 @@ pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
 pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
 /// Default tolerance of the rigid-stroke model's adaptive integrator (README, "work-precision").
 pub const DEFAULT_RIGID_RTOL: f64 = 1e-7;
+/// The largest denominator q of a ratio ωᵢ/ω₀ = p/q that [`Scene::common_period`] recognises.
+pub const MAX_PERIOD_DENOMINATOR: u64 = 64;
+/// The longest common period [`Scene::common_period`] accepts, in periods of the slowest stroke.
+pub const MAX_COMMON_PERIODS: f64 = 64.0;
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+fn lcm(a: u64, b: u64) -> u64 {
+    a / gcd(a, b) * b
+}
+
 /// Default tolerance of the averaged model's adaptive integrator.
 pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 
@@ -426,6 +443,54 @@ impl Scene {
             ));
         }
         Ok(first.period())
+    }
+
+    /// The common period of all strokes (s): 2π/ω when the ω agree; when they differ but are
+    /// commensurate (every ratio ωᵢ/ω₀ a fraction p/q with q ≤ [`MAX_PERIOD_DENOMINATOR`], to 1e-12),
+    /// the least common multiple of the periods, if at most [`MAX_COMMON_PERIODS`] of the longest.
+    pub fn common_period(&self) -> Result<f64> {
+        let first = self.swimmers.first().ok_or_else(|| {
+            unsupported(
+                "the scene has no swimmers, so no period",
+                &[Setting::AddSwimmer],
+            )
+        })?;
+        let w0 = first.omega;
+        let mut q_lcm: u64 = 1;
+        let mut fractions = Vec::with_capacity(self.swimmers.len());
+        for (i, d) in self.swimmers.iter().enumerate() {
+            let r = d.omega / w0;
+            let Some((p, q)) = (1..=MAX_PERIOD_DENOMINATOR).find_map(|q| {
+                let p = (r * q as f64).round();
+                ((p * w0 / q as f64 - d.omega).abs() <= 1e-12 * d.omega && p >= 1.0)
+                    .then_some((p as u64, q))
+            }) else {
+                return Err(invalid!(
+                    "swimmer {i} strokes at omega = {} 1/s against swimmer 0's {w0} 1/s, a ratio that is no fraction p/q with q <= {MAX_PERIOD_DENOMINATOR}, so the strokes have no common period; give the swimmers commensurate omega, or use an integrator other than stroboscopic",
+                    d.omega
+                ));
+            };
+            q_lcm = lcm(q_lcm, q);
+            fractions.push((p, q));
+        }
+        // ωᵢ = ω₀ nᵢ / Q with integer nᵢ; the common frequency is ω₀ gcd(nᵢ) / Q.
+        let g = fractions
+            .iter()
+            .map(|(p, q)| p * (q_lcm / q))
+            .fold(0, gcd);
+        let t = 2.0 * std::f64::consts::PI * q_lcm as f64 / (w0 * g as f64);
+        let longest = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(0.0, f64::max);
+        if t > MAX_COMMON_PERIODS * longest * (1.0 + 1e-12) {
+            return Err(invalid!(
+                "the strokes' common period is {t:e} s, {:.0} times the longest stroke: stroboscopic samples that long gain nothing; give the swimmers simpler omega ratios, or use an integrator other than stroboscopic",
+                t / longest
+            ));
+        }
+        Ok(t)
     }
 
     fn check_index(&self, i: usize) -> Result<()> {

@@ -13,8 +13,7 @@ use super::model::Model;
 use super::scene::Scene;
 use std::sync::Arc;
 
-/// Asked at every step boundary whether the run should stop (e.g. after Ctrl-C). It must be cheap.
-pub type Interrupt = Arc<dyn Fn() -> bool + Send + Sync>;
+pub use super::integrators::Interrupt;
 
 /// A run's progress report: called with the scene time after every CPU step and after every
 /// device run segment, e.g. to draw a progress bar. It must be cheap.
@@ -118,8 +117,9 @@ pub fn advance_cpu(
             st.reset();
             st
         }
-        _ => spec.build(),
+        _ => s.stepper(spec)?,
     };
+    stepper.set_interrupt(control.interrupt.clone());
     let mut outcome = Ok(());
     let mut taken = 0;
     while s.time < t_end && taken < max_steps {
@@ -132,6 +132,11 @@ pub fn advance_cpu(
             Ok(t) => {
                 s.time = t;
                 control.report(s.time);
+            }
+            // A long step given up on the interrupt.
+            Err(_) if control.interrupted() => {
+                outcome = Err(EngineError::Interrupted { time: s.time });
+                break;
             }
             Err(f) => {
                 outcome = Err(EngineError::StepFailed {

@@ -26,6 +26,13 @@ pub fn register(engine: &mut Engine) {
             lift(make(number(&what, &v)?))
         });
     }
+    engine.register_fn(
+        "stroboscopic",
+        |tol: Dynamic, inner: IntegratorSpec| -> ScriptResult<IntegratorSpec> {
+            let tol = number("stroboscopic(tol, inner): tol", &tol)?;
+            lift(IntegratorSpec::stroboscopic_with(tol, Some(inner)))
+        },
+    );
     super::convert::register_display::<IntegratorSpec>(engine);
     engine.register_fn("==", |a: IntegratorSpec, b: IntegratorSpec| a == b);
 }

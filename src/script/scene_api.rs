@@ -391,6 +391,8 @@ pub fn register(engine: &mut Engine) {
                 "rejected_by_guard".into(),
                 (st.rejected_by_guard as INT).into(),
             );
+            m.insert("macro_steps".into(), (st.macro_steps as INT).into());
+            m.insert("micro_periods".into(), (st.micro_periods as INT).into());
             m
         });
 }

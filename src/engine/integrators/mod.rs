@@ -10,14 +10,16 @@ mod euler;
 mod rk4;
 mod rosenbrock;
 mod spec;
+mod stroboscopic;
 mod system;
 
 pub use dopri5::Dopri5;
 pub use euler::Euler;
 pub use rk4::Rk4;
 pub use rosenbrock::Rosenbrock;
-pub use spec::{IntegratorSpec, Method, METHODS};
+pub use spec::{Direct, IntegratorSpec, Method, METHODS};
+pub use stroboscopic::{Stroboscopic, MIN_MACRO};
 pub use system::{
-    require_resolvable, uniform_steps, OdeSystem, Problem, Stats, StepFailure, Stepper,
+    require_resolvable, uniform_steps, Interrupt, OdeSystem, Problem, Stats, StepFailure, Stepper,
     MIN_RELATIVE_INTERVAL,
 };

@@ -1,6 +1,7 @@
 //! The user's choice of integrator, as saved with a scene.
 
 use super::{Dopri5, Euler, Rk4, Rosenbrock, Stepper};
+use crate::engine::error::invalid;
 use crate::engine::error::{require_positive, Result};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -29,6 +30,67 @@ pub enum IntegratorSpec {
         /// Relative tolerance (as for dopri5).
         rtol: f64,
     },
+    /// Stroboscopic averaging (see [`super::Stroboscopic`]): macro steps of many periods on
+    /// samples of the stroboscopic map, taken by `inner` (`None`: the model's choice).
+    Stroboscopic {
+        /// Tolerance relative to the drift.
+        tol: f64,
+        /// The microscopic integrator that samples the stroboscopic map.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        inner: Option<Direct>,
+    },
+}
+
+/// A direct method: stroboscopic averaging's inner integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "lowercase")]
+pub enum Direct {
+    /// See [`IntegratorSpec::Euler`].
+    Euler {
+        /// Maximum step (s).
+        dt: f64,
+    },
+    /// See [`IntegratorSpec::Rk4`].
+    Rk4 {
+        /// Maximum step (s).
+        dt: f64,
+    },
+    /// See [`IntegratorSpec::Dopri5`].
+    Dopri5 {
+        /// Relative tolerance.
+        rtol: f64,
+    },
+    /// See [`IntegratorSpec::Rosw`].
+    Rosw {
+        /// Relative tolerance.
+        rtol: f64,
+    },
+}
+
+impl From<Direct> for IntegratorSpec {
+    fn from(d: Direct) -> Self {
+        match d {
+            Direct::Euler { dt } => IntegratorSpec::Euler { dt },
+            Direct::Rk4 { dt } => IntegratorSpec::Rk4 { dt },
+            Direct::Dopri5 { rtol } => IntegratorSpec::Dopri5 { rtol },
+            Direct::Rosw { rtol } => IntegratorSpec::Rosw { rtol },
+        }
+    }
+}
+
+impl TryFrom<IntegratorSpec> for Direct {
+    type Error = crate::engine::error::EngineError;
+    fn try_from(s: IntegratorSpec) -> Result<Self> {
+        match s {
+            IntegratorSpec::Euler { dt } => Ok(Direct::Euler { dt }),
+            IntegratorSpec::Rk4 { dt } => Ok(Direct::Rk4 { dt }),
+            IntegratorSpec::Dopri5 { rtol } => Ok(Direct::Dopri5 { rtol }),
+            IntegratorSpec::Rosw { rtol } => Ok(Direct::Rosw { rtol }),
+            IntegratorSpec::Stroboscopic { .. } => Err(invalid!(
+                "stroboscopic averaging cannot sample itself; give a direct inner integrator such as rk4(dt) or dopri5(rtol)"
+            )),
+        }
+    }
 }
 
 /// One integrator method as users name it: the name, its one parameter, and a checked
@@ -71,6 +133,13 @@ pub const METHODS: &[Method] = &[
         make: IntegratorSpec::dopri5,
     },
     Method {
+        name: "stroboscopic",
+        parameter: "tol",
+        parameter_about: "the tolerance relative to the drift",
+        about: "stroboscopic averaging: macro steps of many periods (spring and rigid models)",
+        make: IntegratorSpec::stroboscopic,
+    },
+    Method {
         name: "rosw",
         parameter: "rtol",
         parameter_about: "the relative tolerance",
@@ -87,6 +156,7 @@ impl IntegratorSpec {
             IntegratorSpec::Rk4 { .. } => "rk4",
             IntegratorSpec::Dopri5 { .. } => "dopri5",
             IntegratorSpec::Rosw { .. } => "rosw",
+            IntegratorSpec::Stroboscopic { .. } => "stroboscopic",
         };
         METHODS
             .iter()
@@ -99,6 +169,7 @@ impl IntegratorSpec {
         match *self {
             IntegratorSpec::Euler { dt } | IntegratorSpec::Rk4 { dt } => dt,
             IntegratorSpec::Dopri5 { rtol } | IntegratorSpec::Rosw { rtol } => rtol,
+            IntegratorSpec::Stroboscopic { tol, .. } => tol,
         }
     }
 
@@ -124,14 +195,33 @@ impl IntegratorSpec {
         check_rtol("rosw", rtol).map(|rtol| IntegratorSpec::Rosw { rtol })
     }
 
-    /// A fresh stepper for this spec.
-    pub fn build(&self) -> Box<dyn Stepper> {
-        match *self {
+    /// Stroboscopic averaging with the model's inner integrator, checked: 1e-10 ≤ tol < 1.
+    pub fn stroboscopic(tol: f64) -> Result<Self> {
+        Self::stroboscopic_with(tol, None)
+    }
+
+    /// Stroboscopic averaging sampled by `inner`, checked.
+    pub fn stroboscopic_with(tol: f64, inner: Option<IntegratorSpec>) -> Result<Self> {
+        require_positive("stroboscopic(tol): tol", tol, "dimensionless")?;
+        if !(1e-10..1.0).contains(&tol) {
+            return Err(invalid!(
+                "stroboscopic(tol): tol must lie in [1e-10, 1) (below 1e-10 the samples' round-off is larger than what is asked), got {tol:e}"
+            ));
+        }
+        let inner = inner.map(Direct::try_from).transpose()?;
+        Ok(IntegratorSpec::Stroboscopic { tol, inner })
+    }
+
+    /// A fresh stepper for a direct method; `None` for stroboscopic averaging, which the scene
+    /// builds (it needs the period and the model's time scales).
+    pub fn build(&self) -> Option<Box<dyn Stepper>> {
+        Some(match *self {
             IntegratorSpec::Euler { dt } => Box::new(Euler::new(dt)),
             IntegratorSpec::Rk4 { dt } => Box::new(Rk4::new(dt)),
             IntegratorSpec::Dopri5 { rtol } => Box::new(Dopri5::new(rtol)),
             IntegratorSpec::Rosw { rtol } => Box::new(Rosenbrock::new(rtol)),
-        }
+            IntegratorSpec::Stroboscopic { .. } => return None,
+        })
     }
 }
 
@@ -139,7 +229,7 @@ impl IntegratorSpec {
 fn check_rtol(method: &str, rtol: f64) -> Result<f64> {
     require_positive(&format!("{method}(rtol): rtol"), rtol, "dimensionless")?;
     if !(1e-14..1.0).contains(&rtol) {
-        return Err(crate::engine::error::invalid!(
+        return Err(invalid!(
             "{method}(rtol): rtol must lie in [1e-14, 1) (below 1e-14 the error estimate is round-off), got {rtol:e}"
         ));
     }
@@ -148,6 +238,13 @@ fn check_rtol(method: &str, rtol: f64) -> Result<f64> {
 
 impl fmt::Display for IntegratorSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}({:e})", self.method().name, self.parameter())
+        write!(f, "{}({:e}", self.method().name, self.parameter())?;
+        if let IntegratorSpec::Stroboscopic {
+            inner: Some(inner), ..
+        } = self
+        {
+            write!(f, ", {}", IntegratorSpec::from(*inner))?;
+        }
+        f.write_str(")")
     }
 }

@@ -62,7 +62,20 @@ pub struct Stats {
     /// Of the rejected attempts, those whose state failed a guard (NaN, overlap, runaway spring).
     #[serde(default)]
     pub rejected_by_guard: u64,
+    /// Accepted macro steps of stroboscopic averaging (saved only when non-zero).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub macro_steps: u64,
+    /// Microscopic periods stroboscopic averaging integrated (samples, transients, remainders).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub micro_periods: u64,
 }
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
+
+/// Asked at step boundaries whether a run should stop (e.g. after Ctrl-C). It must be cheap.
+pub type Interrupt = std::sync::Arc<dyn Fn() -> bool + Send + Sync>;
 
 /// One time-stepping method.
 pub trait Stepper: Send + Sync {
@@ -79,6 +92,11 @@ pub trait Stepper: Send + Sync {
 
     /// Forget anything cached about the previous state (call when the state was changed from outside).
     fn reset(&mut self) {}
+
+    /// A stepper whose one step is long (many periods) asks `interrupt` inside it and gives the
+    /// step up, state unchanged, with a failure; the caller, seeing the interrupt set, reports
+    /// the interrupt. Steppers of one short step ignore it (their caller asks between steps).
+    fn set_interrupt(&mut self, _interrupt: Option<Interrupt>) {}
 }
 
 /// Size every scratch buffer of a stepper to the state's length (allocates only when it grows).

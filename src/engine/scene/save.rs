@@ -70,6 +70,13 @@ impl Scene {
             Some(IntegratorSpec::Rk4 { dt }) => IntegratorSpec::rk4(dt).map(|_| ())?,
             Some(IntegratorSpec::Dopri5 { rtol }) => IntegratorSpec::dopri5(rtol).map(|_| ())?,
             Some(IntegratorSpec::Rosw { rtol }) => IntegratorSpec::rosw(rtol).map(|_| ())?,
+            Some(IntegratorSpec::Stroboscopic { tol, inner }) => {
+                let inner = inner.map(IntegratorSpec::from);
+                if let Some(i) = inner {
+                    (i.method().make)(i.parameter())?;
+                }
+                IntegratorSpec::stroboscopic_with(tol, inner).map(|_| ())?
+            }
             None => {}
         }
         if let Some(st) = self.contacts.steric {

@@ -1,0 +1,364 @@
+//! Numerical stroboscopic averaging (after Calvo, Chartier, Murua & Sanz-Serna, "Numerical
+//! stroboscopic averaging for ODEs and DAEs", Appl. Numer. Math. 61 (2011) 1077).
+//!
+//! A T-periodically forced system moves slowly from one period to the next: its stroboscopic map
+//! Ψ: y(t) → y(t + T) is close to the identity. Short microscopic runs of whole periods sample Ψ,
+//! and a macro integrator takes steps of many periods on the smooth flow those samples define.
+//!
+//! - **Slope.** The slope F(y) of the averaged flow at y is read off three consecutive
+//!   stroboscopic points Z_r = Ψ^r(y), Z_{r+1}, Z_{r+2}: the derivative at s = 0 of the quadratic
+//!   through them at s = r, r+1, r+2 periods (second order in T). The first r periods relax what
+//!   is fast (a spring settles at its relaxation rate): only points on the slow manifold enter the
+//!   slope, so the macro flow is not stiff, and an extrapolated stage state slightly off the
+//!   manifold costs nothing. Without fast variables (the rigid-stroke model) r = 0.
+//! - **Macro steps.** Bogacki-Shampine 3(2) (first-same-as-last) in whole periods, H = mT, so every
+//!   macro state is a stroboscopic state of the same phase; every stage's Ψ starts at the step's
+//!   own time. The error estimate is measured against the change the step makes (each 3-vector
+//!   against the largest change of its kind among all swimmers: positions, or orientations, whose
+//!   error turns the drift and so counts against the positions' change as well), not
+//!   against absolute positions: `tol` is relative to the drift. A per-period round-off allowance
+//!   keeps components that do not move from demanding the impossible.
+//! - **Direct runs.** The start transient (whenever the state is not the one this stepper left:
+//!   a fresh run, a changed phase, a loaded scene), a remainder of less than [`MIN_MACRO`] periods
+//!   and the fraction of a period before `t_end` are integrated by the inner (microscopic)
+//!   integrator itself, so a row between period multiples is a true microscopic state.
+
+use super::system::{check_state, Interrupt, OdeSystem, Problem, Stats, StepFailure, Stepper};
+
+/// Fewest periods a macro step spans: a step costs 3 (r + 2) periods of microscopic work, so
+/// fewer are integrated directly.
+pub const MIN_MACRO: u64 = 8;
+
+/// Round-off allowance of the error estimate per period, relative to the size of a component
+/// (positions: the swimmer length scale given; orientations: |b| or |N|). The differences of
+/// stroboscopic points carry ~1e-16 of those sizes; 1e-15 per period leaves room and, against a
+/// drift of ~1e-6 ℓ per period, limits the useful `tol` to ~1e-9.
+const NOISE_PER_PERIOD: f64 = 1e-15;
+
+/// The stroboscopic averaging stepper (see the module docs).
+pub struct Stroboscopic {
+    tol: f64,
+    period: f64,
+    inner: Box<dyn Stepper>,
+    /// Relaxation periods before the slope's three points.
+    relax: u32,
+    /// Periods integrated directly after a start.
+    transient: u32,
+    /// A length scale for the positions' round-off allowance (m).
+    length: f64,
+    /// The next macro step, in periods.
+    h_periods: f64,
+    /// Direct periods still to take after a start.
+    pending_transient: u32,
+    /// The (time, state) this stepper left: anything else is a start.
+    left: Option<(f64, Vec<f64>)>,
+    /// The slope at the state left (first same as last).
+    slope: Option<Vec<f64>>,
+    /// Macro steps of exactly this many periods, every step accepted (convergence studies).
+    fixed: Option<u64>,
+    /// Asked between inner steps: a macro step spans many periods.
+    interrupt: Option<Interrupt>,
+}
+
+impl Stroboscopic {
+    /// A stepper of tolerance `tol` (relative to the drift) for a system of common period `period`
+    /// (s), sampling the stroboscopic map with `inner`, relaxing `relax` periods before each slope
+    /// and integrating `transient` periods directly after a start. `length` (m) scales the
+    /// positions' round-off allowance.
+    pub fn new(
+        tol: f64,
+        period: f64,
+        inner: Box<dyn Stepper>,
+        relax: u32,
+        transient: u32,
+        length: f64,
+    ) -> Self {
+        Stroboscopic {
+            tol,
+            period,
+            inner,
+            relax,
+            transient,
+            length,
+            h_periods: f64::INFINITY,
+            pending_transient: 0,
+            left: None,
+            slope: None,
+            fixed: None,
+            interrupt: None,
+        }
+    }
+
+    /// Take macro steps of exactly `m` periods (≥ 1), accepting every step: for measuring the
+    /// macro method's order, not for use.
+    pub fn with_fixed_macro_steps(mut self, m: u64) -> Self {
+        self.fixed = Some(m.max(1));
+        self
+    }
+
+    /// Integrate `y` directly from `t` to `target` with the inner stepper.
+    fn direct(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        mut t: f64,
+        y: &mut [f64],
+        target: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure> {
+        self.inner.reset();
+        while t < target {
+            self.stop_if_interrupted(t)?;
+            t = self.inner.step(sys, t, y, target, stats)?;
+        }
+        Ok(t)
+    }
+
+    /// Give the step up when the interrupt is set (the caller reports the interrupt).
+    fn stop_if_interrupted(&self, t: f64) -> Result<(), StepFailure> {
+        if self.interrupt.as_ref().is_some_and(|f| f()) {
+            return Err(StepFailure {
+                time: t,
+                problem: Problem {
+                    swimmer: None,
+                    cause: "interrupted".into(),
+                    hint: String::new(),
+                    fixes: Vec::new(),
+                },
+            });
+        }
+        Ok(())
+    }
+
+    /// `periods` stroboscopic periods of `y` from the phase of time `t` (the run's own time is not
+    /// changed: Ψ depends on the phase only).
+    fn psi(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        periods: u32,
+        stats: &mut Stats,
+    ) -> Result<(), StepFailure> {
+        for k in 0..periods {
+            let (a, b) = (
+                t + k as f64 * self.period,
+                t + (k + 1) as f64 * self.period,
+            );
+            self.direct(sys, a, y, b, stats)?;
+            stats.micro_periods += 1;
+        }
+        Ok(())
+    }
+
+    /// The slope of the averaged flow at `y` (phase of `t`), from Ψ^r, Ψ^{r+1}, Ψ^{r+2}.
+    fn slope_at(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        stats: &mut Stats,
+    ) -> Result<Vec<f64>, StepFailure> {
+        let r = self.relax as f64;
+        // Derivative at 0 of the Lagrange basis on the nodes r, r+1, r+2 (in periods).
+        let nodes = [r, r + 1.0, r + 2.0];
+        let w: Vec<f64> = (0..3)
+            .map(|j| {
+                let (a, b) = ((j + 1) % 3, (j + 2) % 3);
+                let denom = (nodes[j] - nodes[a]) * (nodes[j] - nodes[b]);
+                -(nodes[a] + nodes[b]) / denom / self.period
+            })
+            .collect();
+        let mut z = y.to_vec();
+        self.psi(sys, t, &mut z, self.relax, stats)?;
+        let mut f: Vec<f64> = z.iter().map(|v| w[0] * v).collect();
+        let t_r = t + r * self.period;
+        for wj in &w[1..] {
+            self.psi(sys, t_r, &mut z, 1, stats)?;
+            for (fi, zi) in f.iter_mut().zip(&z) {
+                *fi += wj * zi;
+            }
+        }
+        Ok(f)
+    }
+
+    /// Max over 3-vectors of |err| / (tol · largest change of that kind + round-off allowance).
+    fn error_norm(&self, y: &[f64], y_new: &[f64], err: &[f64], m: u64) -> f64 {
+        let blocks = y.len() / 3;
+        let norm3 = |v: &[f64], b: usize| {
+            let s = &v[3 * b..3 * b + 3];
+            (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
+        };
+        let mut change = [0.0f64; 2];
+        let mut size = [self.length, 0.0f64];
+        let diff: Vec<f64> = y_new.iter().zip(y).map(|(a, b)| a - b).collect();
+        for b in 0..blocks {
+            change[b % 2] = change[b % 2].max(norm3(&diff, b));
+            if b % 2 == 1 {
+                size[1] = size[1].max(norm3(y, b));
+            }
+        }
+        // An orientation error δ turns the drift by δ/|b|: it is measured against the larger of
+        // the orientations' own change and the positions' change scaled to |b|.
+        let moved = [change[0], change[1].max(change[0] * size[1] / self.length)];
+        let allowance = |c: usize| self.tol * moved[c] + m as f64 * NOISE_PER_PERIOD * size[c];
+        (0..blocks)
+            .map(|b| norm3(err, b) / allowance(b % 2))
+            .fold(0.0, f64::max)
+    }
+
+    /// One macro step of `m` periods from (t, y): the new state, its slope and the error norm,
+    /// or `None` when a stage state failed a guard (the step is then too long).
+    fn macro_step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        k1: &[f64],
+        m: u64,
+        stats: &mut Stats,
+    ) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+        let h = m as f64 * self.period;
+        let n = y.len();
+        let stage = |c: &[(f64, &[f64])]| -> Vec<f64> {
+            (0..n)
+                .map(|i| y[i] + h * c.iter().map(|(a, k)| a * k[i]).sum::<f64>())
+                .collect()
+        };
+        let y2 = stage(&[(0.5, k1)]);
+        let k2 = self.slope_at(sys, t, &y2, stats).ok()?;
+        let y3 = stage(&[(0.75, &k2)]);
+        let k3 = self.slope_at(sys, t, &y3, stats).ok()?;
+        let mut y_new = stage(&[(2.0 / 9.0, k1), (1.0 / 3.0, &k2), (4.0 / 9.0, &k3)]);
+        sys.project(&mut y_new);
+        let t_new = t + h;
+        check_state(sys, t_new, &y_new).ok()?;
+        let k4 = self.slope_at(sys, t, &y_new, stats).ok()?;
+        let err: Vec<f64> = (0..n)
+            .map(|i| {
+                h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i]
+                    - 1.0 / 8.0 * k4[i])
+            })
+            .collect();
+        let e = self.error_norm(y, &y_new, &err, m);
+        Some((y_new, k4, e))
+    }
+
+    fn leave(&mut self, t: f64, y: &[f64]) -> f64 {
+        match &mut self.left {
+            Some((lt, ly)) => {
+                *lt = t;
+                ly.clear();
+                ly.extend_from_slice(y);
+            }
+            None => self.left = Some((t, y.to_vec())),
+        }
+        t
+    }
+}
+
+impl Stepper for Stroboscopic {
+    fn step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure> {
+        let period = self.period;
+        let started = !matches!(&self.left, Some((lt, ly)) if *lt == t && ly.as_slice() == &*y);
+        if started {
+            self.pending_transient = self.transient;
+            self.slope = None;
+            // First try the whole run in one macro step: a slow motion takes it, and a rejection
+            // costs one step's samples.
+            self.h_periods = f64::INFINITY;
+        }
+        let whole = ((t_end - t) / period + 1e-9).floor().max(0.0) as u64;
+        let min_macro = self.fixed.unwrap_or(MIN_MACRO);
+        // A time within rounding of t_end is t_end.
+        let snap = |t_new: f64| {
+            if (t_end - t_new).abs() <= 1e-9 * period {
+                t_end
+            } else {
+                t_new
+            }
+        };
+        // Direct: the transient, a short remainder, and the last fraction of a period.
+        if self.pending_transient > 0 || whole < min_macro {
+            let target = if whole >= 1 { snap(t + period) } else { t_end };
+            let mut trial = y.to_vec();
+            let t_new = self.direct(sys, t, &mut trial, target, stats)?;
+            if whole >= 1 {
+                stats.micro_periods += 1;
+                self.pending_transient = self.pending_transient.saturating_sub(1);
+            }
+            y.copy_from_slice(&trial);
+            self.slope = None;
+            return Ok(self.leave(t_new, y));
+        }
+        let k1 = match self.slope.take() {
+            Some(k) => k,
+            None => self.slope_at(sys, t, y, stats)?,
+        };
+        let mut rejects = 0;
+        loop {
+            let m = match self.fixed {
+                Some(m) => m,
+                None => (self.h_periods.min(whole as f64).floor() as u64).clamp(MIN_MACRO, whole),
+            };
+            let attempt = self.macro_step(sys, t, y, &k1, m, stats);
+            if std::env::var_os("STROBO_DEBUG").is_some() {
+                eprintln!("t/T={:.1} m={m} e={:?}", t / period, attempt.as_ref().map(|a| a.2));
+            }
+            match attempt {
+                Some((y_new, k4, e)) if e <= 1.0 || self.fixed.is_some() => {
+                    let t_new = snap(t + m as f64 * period);
+                    let grow = if e > 0.0 {
+                        (0.9 * e.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
+                    } else {
+                        5.0
+                    };
+                    self.h_periods = (m as f64 * grow).max(MIN_MACRO as f64);
+                    y.copy_from_slice(&y_new);
+                    self.slope = Some(k4);
+                    stats.macro_steps += 1;
+                    return Ok(self.leave(t_new, y));
+                }
+                outcome => {
+                    self.stop_if_interrupted(t)?;
+                    stats.rejected += 1;
+                    let shrink = match outcome {
+                        Some((_, _, e)) if e.is_finite() => {
+                            (0.9 * e.powf(-1.0 / 3.0)).clamp(0.2, 0.9)
+                        }
+                        _ => {
+                            stats.rejected_by_guard += 1;
+                            0.25
+                        }
+                    };
+                    rejects += 1;
+                    if m == MIN_MACRO || rejects > 20 {
+                        // The motion is not slow at this tolerance: one period directly.
+                        self.h_periods = 2.0 * MIN_MACRO as f64;
+                        let mut trial = y.to_vec();
+                        let t_new = self.direct(sys, t, &mut trial, snap(t + period), stats)?;
+                        stats.micro_periods += 1;
+                        y.copy_from_slice(&trial);
+                        return Ok(self.leave(t_new, y));
+                    }
+                    self.h_periods = m as f64 * shrink;
+                }
+            }
+        }
+    }
+
+    fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
+        self.interrupt = interrupt;
+    }
+
+    fn reset(&mut self) {
+        // Kept: the step size and the slope of the state left; `step` restarts (transient and
+        // all) only if it is handed another state.
+    }
+}
