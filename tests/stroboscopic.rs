@@ -8,7 +8,9 @@ use common::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use swimlab::engine::integrators::{OdeSystem, Rk4, Stats, Stepper, Stroboscopic};
-use swimlab::engine::{Dumbbell, EngineError, IntegratorSpec, Observable, Scene, Simulation, Trigger};
+use swimlab::engine::{
+    Dumbbell, EngineError, IntegratorSpec, Observable, Scene, Simulation, Trigger,
+};
 
 /// x' = −εx + A cos(2πt) in component 0 (the rest constant): a slow decay under a fast forcing of
 /// period 1, solved exactly: x(t) = (x₀ − p(0)) e^{−εt} + p(t), p the periodic solution.
@@ -20,7 +22,9 @@ struct Forced {
 impl Forced {
     fn exact(&self, x0: f64, t: f64) -> f64 {
         let w = 2.0 * std::f64::consts::PI;
-        let p = |t: f64| self.a * (self.eps * (w * t).cos() + w * (w * t).sin()) / (self.eps.powi(2) + w * w);
+        let p = |t: f64| {
+            self.a * (self.eps * (w * t).cos() + w * (w * t).sin()) / (self.eps.powi(2) + w * w)
+        };
         (x0 - p(0.0)) * (-self.eps * t).exp() + p(t)
     }
 }
@@ -84,12 +88,16 @@ fn the_transient_is_the_direct_run() {
     // With the default RK4 as the inner integrator, the first period (the spring settling from
     // L(0)) is integrated directly: the row at T is the direct run's, to the bit.
     let dt = mirror_inwards(10.0, true).default_micro_step();
-    let spec = IntegratorSpec::stroboscopic_with(1e-5, Some(IntegratorSpec::rk4(dt).unwrap())).unwrap();
+    let spec =
+        IntegratorSpec::stroboscopic_with(1e-5, Some(IntegratorSpec::rk4(dt).unwrap())).unwrap();
     let mut a = fig1_pair(Some(spec));
     let mut b = fig1_pair(None);
     for s in [&mut a, &mut b] {
-        s.record(vec![Observable::CenterH(0), Observable::Length(1)], Trigger::EveryPeriods(1.0))
-            .unwrap();
+        s.record(
+            vec![Observable::CenterH(0), Observable::Length(1)],
+            Trigger::EveryPeriods(1.0),
+        )
+        .unwrap();
         s.run_periods(1.0).unwrap();
     }
     assert_eq!(a.recorder(0).unwrap().rows, b.recorder(0).unwrap().rows);
@@ -100,8 +108,11 @@ fn rows_land_at_and_between_period_multiples() {
     let t = mirror_inwards(10.0, true).period().unwrap();
     let times = vec![20.0 * t, 37.25 * t, 90.0 * t];
     let mut s = fig1_pair(Some(IntegratorSpec::stroboscopic(1e-4).unwrap()));
-    s.record(vec![Observable::CenterH(0)], Trigger::AtTimes(times.clone()))
-        .unwrap();
+    s.record(
+        vec![Observable::CenterH(0)],
+        Trigger::AtTimes(times.clone()),
+    )
+    .unwrap();
     s.run_periods(37.0).unwrap();
     // The row at 37.25 T is a direct microscopic run from the stroboscopic state at 37 T.
     let inner = s.stroboscopic_inner(1e-4);
@@ -113,7 +124,11 @@ fn rows_land_at_and_between_period_multiples() {
     let got: Vec<f64> = rows.iter().map(|r| r[0]).collect();
     assert_eq!(got, times);
     let c = direct.center(0).unwrap();
-    assert_eq!(&rows[1][1..], &[c.x, c.y, c.z], "the row between multiples is the direct state");
+    assert_eq!(
+        &rows[1][1..],
+        &[c.x, c.y, c.z],
+        "the row between multiples is the direct state"
+    );
     assert!(s.stats().macro_steps >= 2, "{:?}", s.stats());
 }
 
@@ -154,7 +169,8 @@ fn guards_fire_inside_the_samples() {
 fn strokes_need_a_common_period() {
     let mut s = Scene::new();
     let d = Dumbbell::default();
-    s.add(d, nalgebra::Vector3::zeros(), nalgebra::Vector3::x()).unwrap();
+    s.add(d, nalgebra::Vector3::zeros(), nalgebra::Vector3::x())
+        .unwrap();
     s.add(
         Dumbbell {
             omega: d.omega * 2f64.sqrt(),
@@ -170,7 +186,8 @@ fn strokes_need_a_common_period() {
     assert!(e.contains("no common period"), "{e}");
     // 500 and 750 1/s: commensurate, common period 2π/250.
     let mut c = Scene::new();
-    c.add(d, nalgebra::Vector3::zeros(), nalgebra::Vector3::x()).unwrap();
+    c.add(d, nalgebra::Vector3::zeros(), nalgebra::Vector3::x())
+        .unwrap();
     c.add(
         Dumbbell {
             omega: 1.5 * d.omega,
@@ -181,7 +198,10 @@ fn strokes_need_a_common_period() {
     )
     .unwrap();
     let t = c.common_period().unwrap();
-    assert!((t - 2.0 * std::f64::consts::PI / 250.0).abs() < 1e-15, "{t}");
+    assert!(
+        (t - 2.0 * std::f64::consts::PI / 250.0).abs() < 1e-15,
+        "{t}"
+    );
     c.set_integrator(Some(IntegratorSpec::stroboscopic(1e-3).unwrap()));
     Simulation::new(c).run(20.0 * t).unwrap();
     // The averaged model is averaged already.
@@ -226,4 +246,45 @@ fn the_error_stays_within_ten_times_the_tolerance() {
         assert!(err <= 10.0 * tol, "tol {tol:e}: error {err:e}");
         assert!(s.stats().macro_steps >= 1);
     }
+}
+
+#[test]
+fn auto_says_what_it_chose_and_why() {
+    let mut s = mirror_inwards(10.0, true);
+    s.set_integrator(Some(IntegratorSpec::auto(1e-4).unwrap()));
+    let (spec, why) = s.auto_choice(1e-4).unwrap();
+    assert!(matches!(spec, IntegratorSpec::Stroboscopic { tol, inner: Some(_) } if tol == 1e-4));
+    assert!(why.contains("common period"), "{why}");
+    assert!(s
+        .integrator_info()
+        .unwrap()
+        .starts_with("auto(1e-4) runs stroboscopic(1e-4, rk4("));
+    // No common period: the inner method directly, and the reason.
+    let mut odd = s.clone();
+    let d = Dumbbell {
+        omega: 500.0 * 2f64.sqrt(),
+        ..*s.swimmer(0).unwrap()
+    };
+    odd.add(
+        d,
+        nalgebra::Vector3::new(0.0, 40e-6, 0.0),
+        nalgebra::Vector3::y(),
+    )
+    .unwrap();
+    let (spec, why) = odd.auto_choice(1e-4).unwrap();
+    assert!(matches!(spec, IntegratorSpec::Rk4 { .. }), "{spec}");
+    assert!(why.contains("no common period"), "{why}");
+    let mut sim = Simulation::new(odd);
+    sim.run(0.01).unwrap();
+    // The averaged model: dopri5 a hundredth of tol, never looser than its default 1e-8.
+    s.set_model(swimlab::engine::Model::Averaged);
+    let chosen = |tol| s.auto_choice(tol).unwrap().0;
+    assert_eq!(chosen(1e-4), IntegratorSpec::Dopri5 { rtol: 1e-8 });
+    assert_eq!(chosen(1e-8), IntegratorSpec::Dopri5 { rtol: 1e-10 });
+    // It runs, and meets its tolerance on the Fig-1 pair as stroboscopic averaging does.
+    let mut a = fig1_pair(Some(IntegratorSpec::auto(1e-3).unwrap()));
+    let mut b = fig1_pair(Some(IntegratorSpec::stroboscopic(1e-3).unwrap()));
+    a.run_periods(300.0).unwrap();
+    b.run_periods(300.0).unwrap();
+    assert_eq!(a.raw_state().0, b.raw_state().0);
 }

@@ -54,6 +54,19 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
                     }
                 }
             }
+            let long = if quick { 200.0 } else { 1e4 };
+            let points = work_precision::long_horizon(long);
+            let t = work_precision::table(&points);
+            println!("\nlong horizon, spring model, {long} periods (errors against dopri5(1e-10) run directly; * = Pareto front):\n{}", t.render());
+            t.write_csv(std::path::Path::new("out/bench/work_precision_long.csv"))
+                .map_err(io)?;
+            if let Some(p) = points.first() {
+                if let Some(f) = plots::work_precision(&points, &p.config) {
+                    let png = "out/bench/work_precision_long.png";
+                    f.save(std::path::Path::new(png))?;
+                    println!("picture: {png}");
+                }
+            }
             println!("\nCSV written to out/bench/");
         }
         Kind::Stability => {

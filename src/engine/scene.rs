@@ -474,10 +474,7 @@ impl Scene {
             fractions.push((p, q));
         }
         // ωᵢ = ω₀ nᵢ / Q with integer nᵢ; the common frequency is ω₀ gcd(nᵢ) / Q.
-        let g = fractions
-            .iter()
-            .map(|(p, q)| p * (q_lcm / q))
-            .fold(0, gcd);
+        let g = fractions.iter().map(|(p, q)| p * (q_lcm / q)).fold(0, gcd);
         let t = 2.0 * std::f64::consts::PI * q_lcm as f64 / (w0 * g as f64);
         let longest = self
             .swimmers

@@ -159,6 +159,9 @@ pub fn register(engine: &mut Engine) {
             s.with_mut(|sc| sc.set_cutoff(c))
         })
         .register_get("integrator", |s: &mut SceneHandle| s.borrow().integrator())
+        .register_get("integrator_info", |s: &mut SceneHandle| {
+            s.with(|sc| sc.integrator_info()).map(ImmutableString::from)
+        })
         .register_set(
             "integrator",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
@@ -197,7 +200,8 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("steric", "numerics", "s.steric -> map or ()\ns.steric = #{ range, stiffness } | ()", "A soft repulsion between spheres of different swimmers: force stiffness * (range - gap) (N) along the line of centres when their surface gap is below range (m). Off by default (). Microscopic model: the forces join the spring forces in the mobility. Averaged model: each swimmer moves as a free-draining rigid dumbbell of length ell under them. Not in the rigid-stroke model; CPU only; costs one O(N^2) pass per right-hand side.", "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3 }; print(s.steric.range);"),
     doc_entry!("cutoff", "numerics", "s.cutoff -> float or ()\ns.cutoff = distance | ()", "Far-field cutoff of the averaged model (m): pairs further apart are left out. Off by default (). Each left-out pair's contribution is bounded by 9/64 v0 (28|A_R|(Lambda/ell) xi^3 + 84 c_J xi^4) with xi = ell/cutoff (README, Suspensions).", "let s = scene(); s.cutoff = 100e-6; print(s.cutoff);"),
     doc_entry!("coefficients", "numerics", "s.coefficients -> string\ns.coefficients = \"paper\" | \"leading_order\"", "Coefficients of the averaged model's I and J terms: as published, or the leading-order ones.", "let s = scene(); s.coefficients = \"leading_order\"; print(s.coefficients);"),
-    doc_entry!("integrator", "numerics", "s.integrator -> Integrator\ns.integrator = euler(dt) | rk4(dt) | dopri5(rtol) | rosw(rtol) | \"default\"", "The time integrator. The default depends on the model and the scene's stiffness.", "let s = scene(); s.add(dumbbell()); print(s.integrator); s.integrator = rk4(5e-6); print(s.integrator);"),
+    doc_entry!("integrator_info", "numerics", "s.integrator_info -> string", "What the integrator runs on this scene: for auto(tol) the method it chose and why, else the integrator and whether it is the model's default.", "let s = scene(); s.add(dumbbell()); s.integrator = auto(1e-3); print(s.integrator_info);"),
+    doc_entry!("integrator", "numerics", "s.integrator -> Integrator\ns.integrator = euler(dt) | rk4(dt) | dopri5(rtol) | rosw(rtol) | stroboscopic(tol) | auto(tol) | \"default\"", "The time integrator. The default depends on the model and the scene's stiffness.", "let s = scene(); s.add(dumbbell()); print(s.integrator); s.integrator = rk4(5e-6); print(s.integrator);"),
     doc_entry!("mu", "numerics", "s.mu -> float\ns.mu = x", "Viscosity (Pa s).", "let s = scene(); s.mu = 2e-3; print(s.mu);"),
     doc_entry!("stiff_rate", "numerics", "s.stiff_rate -> float", "The largest spring relaxation rate k0 (1/gamma1 + 1/gamma2) (1/s); explicit steps need dt below ~2.8/rate.", "let s = scene(); s.add(dumbbell()); print(s.stiff_rate);"),
     doc_entry!("time", "running", "s.time -> float", "Current time (s).", "let s = scene(); print(s.time);"),

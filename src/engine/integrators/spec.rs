@@ -39,6 +39,12 @@ pub enum IntegratorSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         inner: Option<Direct>,
     },
+    /// The cheapest method expected to meet `tol` for the scene at hand, chosen when it runs
+    /// (`Scene::auto_choice` says which and why).
+    Auto {
+        /// Tolerance relative to the drift.
+        tol: f64,
+    },
 }
 
 /// A direct method: stroboscopic averaging's inner integrator.
@@ -86,7 +92,7 @@ impl TryFrom<IntegratorSpec> for Direct {
             IntegratorSpec::Rk4 { dt } => Ok(Direct::Rk4 { dt }),
             IntegratorSpec::Dopri5 { rtol } => Ok(Direct::Dopri5 { rtol }),
             IntegratorSpec::Rosw { rtol } => Ok(Direct::Rosw { rtol }),
-            IntegratorSpec::Stroboscopic { .. } => Err(invalid!(
+            IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => Err(invalid!(
                 "stroboscopic averaging cannot sample itself; give a direct inner integrator such as rk4(dt) or dopri5(rtol)"
             )),
         }
@@ -140,6 +146,14 @@ pub const METHODS: &[Method] = &[
         make: IntegratorSpec::stroboscopic,
     },
     Method {
+        name: "auto",
+        parameter: "tol",
+        parameter_about: "the tolerance relative to the drift",
+        about:
+            "the cheapest method expected to meet tol for the scene (s.integrator_info says which)",
+        make: IntegratorSpec::auto,
+    },
+    Method {
         name: "rosw",
         parameter: "rtol",
         parameter_about: "the relative tolerance",
@@ -157,6 +171,7 @@ impl IntegratorSpec {
             IntegratorSpec::Dopri5 { .. } => "dopri5",
             IntegratorSpec::Rosw { .. } => "rosw",
             IntegratorSpec::Stroboscopic { .. } => "stroboscopic",
+            IntegratorSpec::Auto { .. } => "auto",
         };
         METHODS
             .iter()
@@ -169,7 +184,7 @@ impl IntegratorSpec {
         match *self {
             IntegratorSpec::Euler { dt } | IntegratorSpec::Rk4 { dt } => dt,
             IntegratorSpec::Dopri5 { rtol } | IntegratorSpec::Rosw { rtol } => rtol,
-            IntegratorSpec::Stroboscopic { tol, .. } => tol,
+            IntegratorSpec::Stroboscopic { tol, .. } | IntegratorSpec::Auto { tol } => tol,
         }
     }
 
@@ -202,14 +217,14 @@ impl IntegratorSpec {
 
     /// Stroboscopic averaging sampled by `inner`, checked.
     pub fn stroboscopic_with(tol: f64, inner: Option<IntegratorSpec>) -> Result<Self> {
-        require_positive("stroboscopic(tol): tol", tol, "dimensionless")?;
-        if !(1e-10..1.0).contains(&tol) {
-            return Err(invalid!(
-                "stroboscopic(tol): tol must lie in [1e-10, 1) (below 1e-10 the samples' round-off is larger than what is asked), got {tol:e}"
-            ));
-        }
+        let tol = check_drift_tol("stroboscopic", tol)?;
         let inner = inner.map(Direct::try_from).transpose()?;
         Ok(IntegratorSpec::Stroboscopic { tol, inner })
+    }
+
+    /// The cheapest method for `tol`, chosen when the scene runs, checked: 1e-10 ≤ tol < 1.
+    pub fn auto(tol: f64) -> Result<Self> {
+        check_drift_tol("auto", tol).map(|tol| IntegratorSpec::Auto { tol })
     }
 
     /// A fresh stepper for a direct method; `None` for stroboscopic averaging, which the scene
@@ -220,9 +235,20 @@ impl IntegratorSpec {
             IntegratorSpec::Rk4 { dt } => Box::new(Rk4::new(dt)),
             IntegratorSpec::Dopri5 { rtol } => Box::new(Dopri5::new(rtol)),
             IntegratorSpec::Rosw { rtol } => Box::new(Rosenbrock::new(rtol)),
-            IntegratorSpec::Stroboscopic { .. } => return None,
+            IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => return None,
         })
     }
+}
+
+/// A tolerance relative to the drift: 1e-10 ≤ tol < 1.
+fn check_drift_tol(method: &str, tol: f64) -> Result<f64> {
+    require_positive(&format!("{method}(tol): tol"), tol, "dimensionless")?;
+    if !(1e-10..1.0).contains(&tol) {
+        return Err(invalid!(
+            "{method}(tol): tol must lie in [1e-10, 1) (below 1e-10 the samples' round-off is larger than what is asked), got {tol:e}"
+        ));
+    }
+    Ok(tol)
 }
 
 /// An adaptive method's tolerance: 1e-14 ≤ rtol < 1.

@@ -140,10 +140,7 @@ impl Stroboscopic {
         stats: &mut Stats,
     ) -> Result<(), StepFailure> {
         for k in 0..periods {
-            let (a, b) = (
-                t + k as f64 * self.period,
-                t + (k + 1) as f64 * self.period,
-            );
+            let (a, b) = (t + k as f64 * self.period, t + (k + 1) as f64 * self.period);
             self.direct(sys, a, y, b, stats)?;
             stats.micro_periods += 1;
         }
@@ -308,9 +305,6 @@ impl Stepper for Stroboscopic {
                 None => (self.h_periods.min(whole as f64).floor() as u64).clamp(MIN_MACRO, whole),
             };
             let attempt = self.macro_step(sys, t, y, &k1, m, stats);
-            if std::env::var_os("STROBO_DEBUG").is_some() {
-                eprintln!("t/T={:.1} m={m} e={:?}", t / period, attempt.as_ref().map(|a| a.2));
-            }
             match attempt {
                 Some((y_new, k4, e)) if e <= 1.0 || self.fixed.is_some() => {
                     let t_new = snap(t + m as f64 * period);

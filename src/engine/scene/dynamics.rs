@@ -2,7 +2,7 @@
 //! the right-hand side ([`OdeSystem`]) of the chosen model that every run and query uses.
 
 use super::*;
-use crate::engine::integrators::{Stepper, Stroboscopic};
+use crate::engine::integrators::{Stepper, Stroboscopic, MIN_MACRO};
 
 impl Scene {
     /// Spring tension k0 (d − L) of swimmer `i` (N), or the constraint tension in the rigid-stroke
@@ -112,6 +112,10 @@ impl Scene {
 /// dt⁴ of RK4).
 pub const RK4_DEFAULT_DRIFT_ERROR: f64 = 1.1e-6;
 
+/// RK4 steps per period above which the springs count as stiff: `auto` and stroboscopic
+/// averaging then sample with rosw, whose steps the springs do not limit.
+pub const STIFF_STEPS_PER_PERIOD: f64 = 2e4;
+
 /// e^-37 ≈ 1e-16: a spring mode relaxed this many e-foldings is gone to round-off.
 const RELAXED_E_FOLDINGS: f64 = 37.0;
 
@@ -121,6 +125,9 @@ impl Scene {
     pub(crate) fn stepper(&self, spec: IntegratorSpec) -> Result<Box<dyn Stepper>> {
         if let Some(st) = spec.build() {
             return Ok(st);
+        }
+        if let IntegratorSpec::Auto { tol } = spec {
+            return self.stepper(self.auto_choice(tol)?.0);
         }
         let IntegratorSpec::Stroboscopic { tol, inner } = spec else {
             return Err(invalid!("{spec} has no stepper"));
@@ -146,7 +153,9 @@ impl Scene {
                     .iter()
                     .map(|d| d.relaxation_rate(self.mu))
                     .fold(f64::INFINITY, f64::min);
-                (2.0 * RELAXED_E_FOLDINGS / (slowest * period)).ceil().clamp(1.0, 1e4) as u32
+                (2.0 * RELAXED_E_FOLDINGS / (slowest * period))
+                    .ceil()
+                    .clamp(1.0, 1e4) as u32
             }
             Model::Rigid | Model::Averaged => 0,
         };
@@ -161,6 +170,49 @@ impl Scene {
         )))
     }
 
+    /// What `auto(tol)` runs on this scene, and why. The averaged model: dopri5 a hundred times
+    /// tighter than `tol`, never looser than its default (it is not stiff). The spring and rigid-stroke models with a common
+    /// period: stroboscopic averaging, sampled by [`Scene::stroboscopic_inner`] (runs of fewer
+    /// than [`MIN_MACRO`] periods, the start transient and rows between period multiples take
+    /// that inner method directly); without one, the inner method directly. Springs so stiff
+    /// that RK4 would take more than [`STIFF_STEPS_PER_PERIOD`] steps a period take rosw.
+    pub fn auto_choice(&self, tol: f64) -> Result<(IntegratorSpec, String)> {
+        if self.model == Model::Averaged {
+            let rtol = (tol * 1e-2).clamp(1e-13, DEFAULT_AVERAGED_RTOL);
+            return Ok((
+                IntegratorSpec::Dopri5 { rtol },
+                "the averaged model is not stiff: dopri5 at a hundredth of tol, never looser than its default".into(),
+            ));
+        }
+        let inner = self.stroboscopic_inner(tol);
+        Ok(match self.common_period() {
+            Ok(t) => (
+                IntegratorSpec::Stroboscopic {
+                    tol,
+                    inner: Some(inner.try_into()?),
+                },
+                format!("stroboscopic averaging over the common period {t:.6e} s, sampled by {inner}; runs of fewer than {MIN_MACRO} periods, the start transient and rows between period multiples run {inner} directly"),
+            ),
+            Err(e) => (inner, format!("{inner} directly, without averaging: {e}")),
+        })
+    }
+
+    /// What the integrator in use runs on this scene: `auto(tol)`'s choice and its reason, or
+    /// the integrator itself.
+    pub fn integrator_info(&self) -> Result<String> {
+        let spec = self.integrator();
+        Ok(match spec {
+            IntegratorSpec::Auto { tol } => {
+                let (chosen, why) = self.auto_choice(tol)?;
+                format!("{spec} runs {chosen}: {why}")
+            }
+            _ if self.integrator_is_default() => {
+                format!("{spec}: the {} model's default", self.model.name())
+            }
+            _ => format!("{spec}: as set"),
+        })
+    }
+
     /// Stroboscopic averaging's inner integrator when none is named. The spring model: RK4 (a
     /// fixed step keeps the sampled map smooth in the state) at the step whose drift error is a
     /// tenth of `tol`: RK4's error falls as dt⁴ from [`RK4_DEFAULT_DRIFT_ERROR`] at the default
@@ -172,6 +224,11 @@ impl Scene {
             Model::Rigid => IntegratorSpec::Dopri5 {
                 rtol: (tol * 1e-2).clamp(1e-12, DEFAULT_RIGID_RTOL),
             },
+            Model::Micro if self.stiff_steps_per_period() > STIFF_STEPS_PER_PERIOD => {
+                IntegratorSpec::Rosw {
+                    rtol: (tol * 1e-2).clamp(1e-12, 1e-6),
+                }
+            }
             Model::Micro | Model::Averaged => {
                 let dt0 = self.default_micro_step();
                 let f = (0.1 * tol / RK4_DEFAULT_DRIFT_ERROR).powf(0.25);
@@ -183,10 +240,23 @@ impl Scene {
                         .iter()
                         .map(Dumbbell::period)
                         .fold(f64::INFINITY, f64::min);
-                    (dt0 * f).min(2.0 / self.stiff_rate()).min(t_min / 100.0).max(dt0)
+                    (dt0 * f)
+                        .min(2.0 / self.stiff_rate())
+                        .min(t_min / 100.0)
+                        .max(dt0)
                 };
                 IntegratorSpec::Rk4 { dt }
             }
         }
+    }
+
+    /// RK4 steps per shortest period at the stability-bounded step 2.0/rate.
+    fn stiff_steps_per_period(&self) -> f64 {
+        let t_min = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(f64::INFINITY, f64::min);
+        t_min * self.stiff_rate() / 2.0
     }
 }

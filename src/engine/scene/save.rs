@@ -77,6 +77,7 @@ impl Scene {
                 }
                 IntegratorSpec::stroboscopic_with(tol, inner).map(|_| ())?
             }
+            Some(IntegratorSpec::Auto { tol }) => IntegratorSpec::auto(tol).map(|_| ())?,
             None => {}
         }
         if let Some(st) = self.contacts.steric {
