@@ -106,3 +106,34 @@ fn overlapping_spheres_take_the_overlap_form_in_the_fast_kernel() {
         }
     }
 }
+
+// The overlap guard through cell lists names the pair min_gap names whenever that pair overlaps,
+// and nothing otherwise: 3,000 spheres (above the cell-list threshold) with several overlaps,
+// ties included, and with none.
+#[test]
+fn closest_overlap_through_cell_lists_is_min_gaps_answer() {
+    use swimlab::engine::pairs::{closest_overlap, CELL_LIST_SPHERES};
+    let n = 3000;
+    assert!(n >= CELL_LIST_SPHERES);
+    let clear = lattice(n);
+    let radii = clear.a.clone();
+    let mut s = clear.clone();
+    for (j, i, dx) in [
+        (2500, 17, 0.6e-6),
+        (40, 41, 0.05e-6),
+        (1999, 1000, 0.6e-6),
+        (7, 8, 0.0),
+    ] {
+        s.x[j] = s.x[i] + dx;
+        s.y[j] = s.y[i];
+        s.z[j] = s.z[i];
+    }
+    for parallel in [false, true] {
+        let expected = min_gap(&s, &radii, parallel).filter(|g| g.0 <= 0.0);
+        assert!(expected.is_some());
+        assert_eq!(closest_overlap(&s, &radii, parallel), expected);
+        let none = min_gap(&clear, &radii, parallel).filter(|g| g.0 <= 0.0);
+        assert_eq!(none, None);
+        assert_eq!(closest_overlap(&clear, &radii, parallel), None);
+    }
+}

@@ -77,6 +77,54 @@ fn averaged_rates(s: &Scene, cutoff: Option<f64>) -> Vec<f64> {
     dy
 }
 
+// Cell lists find a cutoff's pairs among the 27 cells around each swimmer; they sum them cell by
+// cell, so the rates equal the all-pairs loop's to the rounding of another order: each 3-vector
+// within 1e-12 of the largest of its kind (≤ 700 terms of both signs, ~1e-16 each).
+#[test]
+fn cell_lists_give_the_all_pairs_rates() {
+    let s = suspension(Model::Averaged, 700, 0.002, asymmetric(), 13);
+    let (y, base) = s.raw_state();
+    let ell = s.swimmers()[0].ell;
+    for cutoff in [3.0 * ell, 8.0 * ell, 1e3 * ell] {
+        for steric in [
+            None,
+            Some(swimlab::engine::Steric::new(1e-7, 1e-3).unwrap()),
+        ] {
+            let rates = |cells: bool| {
+                let mut sys = AveragedSystem::new(s.swimmers(), base, Coefficients::Paper, y);
+                sys.set_cutoff(Some(cutoff));
+                sys.set_contacts(
+                    swimlab::engine::Contacts {
+                        allow_overlap: false,
+                        steric,
+                    },
+                    1e-3,
+                );
+                sys.set_cell_lists(Some(cells));
+                let mut dy = vec![0.0; y.len()];
+                sys.rhs(0.0, y, &mut dy);
+                dy
+            };
+            let (a, b) = (rates(true), rates(false));
+            for kind in [0, 1] {
+                let block = |v: &[f64], i: usize| {
+                    let k = 6 * i + 3 * kind;
+                    Vector3::new(v[k], v[k + 1], v[k + 2])
+                };
+                let n = a.len() / 6;
+                let scale = (0..n).map(|i| block(&b, i).norm()).fold(0.0, f64::max);
+                for i in 0..n {
+                    let d = (block(&a, i) - block(&b, i)).norm();
+                    assert!(
+                        d <= 1e-12 * scale,
+                        "cutoff {cutoff:e}, steric {steric:?}, swimmer {i}: {d:e} of {scale:e}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 // Each row sums its partners in one order whatever thread runs it: 1, 2 or 3 threads give the
 // same bits (300 swimmers is above the parallel threshold).
 #[test]
@@ -307,4 +355,34 @@ fn contact_settings_are_checked() {
     )
     .unwrap_err();
     assert!(e.contains("not available in the rigid-stroke model"), "{e}");
+}
+
+// From 512 swimmers the averaged guard groups equal centres instead of comparing all pairs: it
+// names the same first pair, and a large scene's contact guard goes through cell lists.
+#[test]
+fn large_averaged_guards_name_the_same_swimmers() {
+    let base = suspension(Model::Averaged, 600, 0.001, asymmetric(), 21);
+    let (y, b) = base.raw_state();
+    let check = |y: &[f64], b: &[Vector3<f64>]| {
+        let mut sys = AveragedSystem::new(base.swimmers(), b, Coefficients::Paper, y);
+        swimlab::engine::integrators::OdeSystem::check(&mut sys, 0.0, y).map_err(|p| p.cause)
+    };
+    assert_eq!(check(y, b), Ok(()));
+    // Swimmer 400's centre onto swimmer 123's, then swimmer 300's spheres onto 50's.
+    let mut moved = b.to_vec();
+    let mut y2 = y.to_vec();
+    moved[400] = b[123];
+    y2[6 * 400..6 * 400 + 3].copy_from_slice(&y[6 * 123..6 * 123 + 3]);
+    let e = check(&y2, &moved).unwrap_err();
+    assert!(
+        e.contains("swimmers 123 and 400 have the same centre"),
+        "{e}"
+    );
+    let mut moved = b.to_vec();
+    moved[300] = b[50] + Vector3::new(0.3e-6, 0.0, 0.0);
+    let mut y3 = y.to_vec();
+    y3[6 * 300..6 * 300 + 3].copy_from_slice(&y[6 * 50..6 * 50 + 3]);
+    y3[6 * 300 + 3..6 * 300 + 6].copy_from_slice(&y[6 * 50 + 3..6 * 50 + 6]);
+    let e = check(&y3, &moved).unwrap_err();
+    assert!(e.contains("swimmer 50") && e.contains("swimmer 300"), "{e}");
 }

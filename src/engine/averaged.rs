@@ -15,6 +15,7 @@
 //! another (tests/averaged_model.rs compares every shortcut with the general 3D sum); split, each
 //! piece would need the others' private layout.
 
+use super::cells::CellGrid;
 use super::contacts::Contacts;
 use super::integrators::{OdeSystem, Problem};
 use super::mobility::self_mobility;
@@ -166,7 +167,18 @@ pub struct AveragedSystem {
     gap_soa: SoaSpheres,
     contacts: Contacts,
     mu: f64,
+    /// Cell lists of the centres for a cutoff, rebuilt every right-hand side; `None`: all pairs.
+    grid: Option<CellGrid>,
+    /// The arrays in the grid's order (positions, orientations; sin φ, cos φ in `cell_phase`).
+    cell_soa: Soa,
+    cell_phase: Vec<(f64, f64)>,
+    /// Use cell lists: `None` decides by size ([`CELL_LIST_SWIMMERS`]).
+    cells: Option<bool>,
 }
+
+/// From this many swimmers a cutoff's pairs are found through cell lists: below it the all-pairs
+/// loop is as fast. The two differ only by the rounding of the sums' order ([`super::cells`]).
+pub const CELL_LIST_SWIMMERS: usize = 512;
 
 impl AveragedSystem {
     /// A system for these swimmers with every shortcut; `y` is the current state (used to detect an
@@ -219,6 +231,10 @@ impl AveragedSystem {
             gap_soa: SoaSpheres::default(),
             contacts: Contacts::default(),
             mu: super::model::DEFAULT_MU,
+            grid: None,
+            cells: None,
+            cell_soa: Soa::default(),
+            cell_phase: Vec::new(),
         };
         if shortcuts.aligned_1d {
             sys.axis = sys.common_axis(y);
@@ -254,6 +270,12 @@ impl AveragedSystem {
             (f2 * self_mobility(self.mu, a2) - f1 * self_mobility(self.mu, a1)) / self.coef[s].ell;
         let n = Vector3::new(self.soa.nx[s], self.soa.ny[s], self.soa.nz[s]);
         (v, rel - n * n.dot(&rel))
+    }
+
+    /// Force cell lists on or off for the cutoff's pairs (`None`: by size). The results do not
+    /// depend on it.
+    pub fn set_cell_lists(&mut self, on: Option<bool>) {
+        self.cells = on;
     }
 
     /// Leave out pairs further apart than `cutoff` (m); `None` keeps every pair.
@@ -332,22 +354,20 @@ impl AveragedSystem {
         let with_k = c.a_n != 0.0 || !self.skip_symmetric;
         let mut v = Vector3::zeros();
         let mut t = Vector3::zeros();
-        for r in 0..self.coef.len() {
-            let Some(sin) = self.pair_sin(s, r) else {
-                continue;
-            };
+        // Partner r's data from `src` at slot k (the arrays themselves, or their cell-ordered copy).
+        let mut pair = |src: &Soa, k: usize, sin: f64| {
             let dvec = Vector3::new(
-                soa.x[s] - soa.x[r],
-                soa.y[s] - soa.y[r],
-                soa.z[s] - soa.z[r],
+                soa.x[s] - src.x[k],
+                soa.y[s] - src.y[k],
+                soa.z[s] - src.z[k],
             );
             let d2 = dvec.norm_squared();
             if d2 > self.cutoff2 {
-                continue;
+                return;
             }
             let dist = d2.sqrt();
             let dh = dvec / dist;
-            let nr = Vector3::new(soa.nx[r], soa.ny[r], soa.nz[r]);
+            let nr = Vector3::new(src.nx[k], src.ny[k], src.nz[k]);
             let (ss, rr, q) = (dh.dot(&ns), dh.dot(&nr), ns.dot(&nr));
             let xi = c.ell / dist;
             let (xi3, xi4) = (xi.powi(3), xi.powi(4));
@@ -381,6 +401,29 @@ impl AveragedSystem {
                 tr += dh * (c.a_n * c.w0 * sin * (9.0 / 32.0) * c.big_l * xi4 * jk);
             }
             t += tr;
+        };
+        match &self.grid {
+            None => {
+                for r in 0..self.coef.len() {
+                    if let Some(sin) = self.pair_sin(s, r) {
+                        pair(soa, r, sin);
+                    }
+                }
+            }
+            Some(g) => {
+                let mut runs = Vec::with_capacity(27);
+                g.neighbour_runs(soa.x[s], soa.y[s], soa.z[s], &mut runs);
+                for (a, b) in runs {
+                    for k in a as usize..b as usize {
+                        let r = g.order[k] as usize;
+                        let (sin_r, cos_r) = self.cell_phase[k];
+                        let sin = self.sin_phi[s] * cos_r - self.cos_phi[s] * sin_r;
+                        if s != r && (sin.abs() > SIN_ZERO || !self.skip_zero_phase) {
+                            pair(&self.cell_soa, k, sin);
+                        }
+                    }
+                }
+            }
         }
         (v, t)
     }
@@ -454,7 +497,31 @@ impl OdeSystem for AveragedSystem {
                     self.soa.nx[s] = vec3(y, STATE_PER_SWIMMER * s + 3).dot(&axis);
                 }
             }
-            None => self.fill(y),
+            None => {
+                self.fill(y);
+                let use_cells = self.cutoff2.is_finite()
+                    && self.cells.unwrap_or(self.coef.len() >= CELL_LIST_SWIMMERS);
+                self.grid = use_cells.then(|| {
+                    CellGrid::build(&self.soa.x, &self.soa.y, &self.soa.z, self.cutoff2.sqrt())
+                });
+                if let Some(g) = &self.grid {
+                    let soa = &self.soa;
+                    let pick = |v: &[f64]| g.order.iter().map(|&i| v[i as usize]).collect();
+                    self.cell_soa = Soa {
+                        x: pick(&soa.x),
+                        y: pick(&soa.y),
+                        z: pick(&soa.z),
+                        nx: pick(&soa.nx),
+                        ny: pick(&soa.ny),
+                        nz: pick(&soa.nz),
+                    };
+                    self.cell_phase = g
+                        .order
+                        .iter()
+                        .map(|&i| (self.sin_phi[i as usize], self.cos_phi[i as usize]))
+                        .collect();
+                }
+            }
         }
         if let Some(st) = self.contacts.steric {
             // The sphere models' pair force, on the spheres at length ℓ.
@@ -490,7 +557,26 @@ impl OdeSystem for AveragedSystem {
                 })
                 .map(|r| (s, r))
         };
-        let found = if parallel {
+        let found = if n >= CELL_LIST_SWIMMERS {
+            // Only swimmers with bitwise equal centres share one: group them, O(S).
+            let mut groups: std::collections::HashMap<[u64; 3], Vec<usize>> =
+                std::collections::HashMap::new();
+            for i in 0..n {
+                // + 0.0 makes −0.0 the key of 0.0, as == treats them.
+                let key = [soa.x[i], soa.y[i], soa.z[i]].map(|c| (c + 0.0).to_bits());
+                groups.entry(key).or_default().push(i);
+            }
+            groups
+                .values()
+                .filter(|g| g.len() > 1)
+                .flat_map(|g| {
+                    g.iter()
+                        .enumerate()
+                        .flat_map(move |(k, &s)| g[k + 1..].iter().map(move |&r| (s, r)))
+                })
+                .filter(|&(s, r)| self.pair_sin(s, r).is_some())
+                .min()
+        } else if parallel {
             (0..n).into_par_iter().find_map_first(shared_centre)
         } else {
             (0..n).find_map(shared_centre)
@@ -512,9 +598,9 @@ impl OdeSystem for AveragedSystem {
         for (i, p) in self.sphere_pos.iter().enumerate() {
             (g.x[i], g.y[i], g.z[i]) = (p.x, p.y, p.z);
         }
-        match super::pairs::min_gap(g, &self.radii, parallel) {
-            Some((gap, a, b)) if gap <= 0.0 => Err(super::spheres::overlap_problem(gap, a, b)),
-            _ => Ok(()),
+        match super::pairs::closest_overlap(g, &self.radii, parallel) {
+            Some((gap, a, b)) => Err(super::spheres::overlap_problem(gap, a, b)),
+            None => Ok(()),
         }
     }
 

@@ -10,6 +10,7 @@ pub mod averaged;
 pub mod backend;
 pub mod build;
 pub mod calibrate;
+pub mod cells;
 pub mod choice;
 pub mod contacts;
 pub mod error;

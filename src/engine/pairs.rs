@@ -284,3 +284,59 @@ pub fn min_gap(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f64, us
         (0..n).map(row).fold(None, pick)
     }
 }
+
+/// From this many spheres the overlap guard finds its candidates through cell lists.
+pub const CELL_LIST_SPHERES: usize = 1024;
+
+/// The pair [`min_gap`] would name if its gap is ≤ 0 (the smallest gap, then the smallest i, then
+/// the smallest j), or `None` when no spheres overlap. Overlapping spheres are closer than twice
+/// the largest radius, so from [`CELL_LIST_SPHERES`] spheres on only pairs in neighbouring cells
+/// of that size are measured: O(N) instead of O(N²), the same answer.
+pub fn closest_overlap(
+    s: &SoaSpheres,
+    radii: &[f64],
+    parallel: bool,
+) -> Option<(f64, usize, usize)> {
+    let n = s.len();
+    let reach = 2.0 * radii.iter().copied().fold(0.0, f64::max);
+    if n < CELL_LIST_SPHERES || !(reach > 0.0 && reach.is_finite()) {
+        return min_gap(s, radii, parallel).filter(|g| g.0 <= 0.0);
+    }
+    let grid = super::cells::CellGrid::build(&s.x[..n], &s.y[..n], &s.z[..n], reach);
+    let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
+        if (b.0, b.1, b.2) < (a.0, a.1, a.2) {
+            b
+        } else {
+            a
+        }
+    };
+    let row = |i: usize| -> Option<(f64, usize, usize)> {
+        let mut runs = Vec::with_capacity(27);
+        grid.neighbour_runs(s.x[i], s.y[i], s.z[i], &mut runs);
+        let mut best: Option<(f64, usize, usize)> = None;
+        for (a, b) in runs {
+            for &j in &grid.order[a as usize..b as usize] {
+                let j = j as usize;
+                if j <= i {
+                    continue;
+                }
+                let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
+                let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
+                if gap <= 0.0 {
+                    best = Some(best.map_or((gap, i, j), |x| first(x, (gap, i, j))));
+                }
+            }
+        }
+        best
+    };
+    let pick = |a: Option<(f64, usize, usize)>, b: Option<(f64, usize, usize)>| match (a, b) {
+        (Some(x), Some(y)) => Some(first(x, y)),
+        (x, None) => x,
+        (None, y) => y,
+    };
+    if parallel {
+        (0..n).into_par_iter().map(row).reduce(|| None, pick)
+    } else {
+        (0..n).map(row).fold(None, pick)
+    }
+}

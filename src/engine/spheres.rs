@@ -138,13 +138,6 @@ impl Spheres {
         }
     }
 
-    /// The smallest gap between two spheres (m) at the current positions and the spheres that
-    /// have it; `None` with fewer than two spheres.
-    pub(crate) fn min_gap(&mut self) -> Option<(f64, usize, usize)> {
-        self.fill_soa();
-        pairs::min_gap(&self.soa, &self.radii, self.pos.len() >= PARALLEL_SPHERES)
-    }
-
     /// The force on sphere 1 of dumbbell `s` set by the last [`Spheres::interact`].
     #[inline]
     pub(crate) fn force(&self, s: usize) -> Vector3<f64> {
@@ -176,10 +169,10 @@ impl Spheres {
             });
         }
         if self.pos.len() >= FAST_KERNEL_SPHERES {
-            return match self.min_gap() {
-                Some((gap, a, b)) if gap <= 0.0 => Some(overlap_problem(gap, a, b)),
-                _ => None,
-            };
+            self.fill_soa();
+            let parallel = self.pos.len() >= PARALLEL_SPHERES;
+            return pairs::closest_overlap(&self.soa, &self.radii, parallel)
+                .map(|(gap, a, b)| overlap_problem(gap, a, b));
         }
         let (pos, radii) = (&self.pos, &self.radii);
         let n = pos.len();
