@@ -137,3 +137,40 @@ fn closest_overlap_through_cell_lists_is_min_gaps_answer() {
         assert_eq!(closest_overlap(&clear, &radii, parallel), None);
     }
 }
+
+// min_gap through cell lists (3,000 spheres, above the threshold) is the all-pairs answer: the
+// same gap bits and the same pair, clear of overlaps and with them, and on a line of spheres
+// (a flat bounding box).
+#[test]
+fn min_gap_through_cell_lists_is_the_all_pairs_answer() {
+    let n = 3000;
+    let s = lattice(n);
+    let radii = s.a.clone();
+    let brute = |s: &swimlab::engine::pairs::SoaSpheres| {
+        let mut best = (f64::INFINITY, 0, 0);
+        for i in 0..n {
+            for j in i + 1..n {
+                let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
+                let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
+                if gap < best.0 {
+                    best = (gap, i, j);
+                }
+            }
+        }
+        best
+    };
+    let mut moved = s.clone();
+    moved.x[2500] = moved.x[17] + 2.9e-6;
+    moved.y[2500] = moved.y[17];
+    moved.z[2500] = moved.z[17];
+    let mut line = s.clone();
+    for i in 0..n {
+        (line.x[i], line.y[i], line.z[i]) = (i as f64 * 3e-6 + (i % 7) as f64 * 1e-8, 0.0, 0.0);
+    }
+    for case in [&s, &moved, &line] {
+        let expected = brute(case);
+        for parallel in [false, true] {
+            assert_eq!(min_gap(case, &radii, parallel), Some(expected));
+        }
+    }
+}

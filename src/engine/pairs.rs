@@ -257,6 +257,73 @@ pub fn interaction_velocities(
 /// The smallest gap |x_i − x_j| − a_i − a_j over all pairs and a pair that has it (rows in
 /// parallel when `parallel`). `None` for fewer than two spheres.
 pub fn min_gap(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f64, usize, usize)> {
+    if s.len() >= CELL_LIST_SPHERES {
+        if let Some(found) = min_gap_by_cells(s, radii, parallel) {
+            return Some(found);
+        }
+    }
+    min_gap_all_pairs(s, radii, parallel)
+}
+
+/// [`min_gap`] through cell lists, when that is certain to be the answer: cells of twice the mean
+/// spacing (at least twice the largest radius) hold every pair closer than their side; if the
+/// smallest gap among them, g, has g + 2·a_max below the side, the closest pair overall (whose
+/// distance is at most that) is among them. `None` when it is not certain (then all pairs).
+fn min_gap_by_cells(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f64, usize, usize)> {
+    let n = s.len();
+    let a_max = radii.iter().copied().fold(0.0, f64::max);
+    let extent = |v: &[f64]| {
+        let (lo, hi) = v[..n]
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+                (l.min(x), h.max(x))
+            });
+        (hi - lo).max(0.0)
+    };
+    let volume = extent(&s.x) * extent(&s.y) * extent(&s.z);
+    let side = (2.0 * (volume / n as f64).cbrt()).max(2.0 * a_max);
+    if !(side > 0.0 && side.is_finite()) {
+        return None;
+    }
+    let grid = super::cells::CellGrid::build(&s.x[..n], &s.y[..n], &s.z[..n], side);
+    let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
+        if (b.0, b.1, b.2) < (a.0, a.1, a.2) {
+            b
+        } else {
+            a
+        }
+    };
+    let row = |i: usize| -> Option<(f64, usize, usize)> {
+        let mut runs = Vec::with_capacity(27);
+        grid.neighbour_runs(s.x[i], s.y[i], s.z[i], &mut runs);
+        let mut best: Option<(f64, usize, usize)> = None;
+        for (a, b) in runs {
+            for &j in &grid.order[a as usize..b as usize] {
+                let j = j as usize;
+                if j <= i {
+                    continue;
+                }
+                let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
+                let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
+                best = Some(best.map_or((gap, i, j), |x| first(x, (gap, i, j))));
+            }
+        }
+        best
+    };
+    let pick = |a: Option<(f64, usize, usize)>, b: Option<(f64, usize, usize)>| match (a, b) {
+        (Some(x), Some(y)) => Some(first(x, y)),
+        (x, None) => x,
+        (None, y) => y,
+    };
+    let found = if parallel {
+        (0..n).into_par_iter().map(row).reduce(|| None, pick)
+    } else {
+        (0..n).map(row).fold(None, pick)
+    }?;
+    (found.0 + 2.0 * a_max < side).then_some(found)
+}
+
+fn min_gap_all_pairs(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f64, usize, usize)> {
     let n = s.len();
     let row = |i: usize| -> Option<(f64, usize, usize)> {
         let mut best: Option<(f64, usize, usize)> = None;
@@ -300,7 +367,7 @@ pub fn closest_overlap(
     let n = s.len();
     let reach = 2.0 * radii.iter().copied().fold(0.0, f64::max);
     if n < CELL_LIST_SPHERES || !(reach > 0.0 && reach.is_finite()) {
-        return min_gap(s, radii, parallel).filter(|g| g.0 <= 0.0);
+        return min_gap_all_pairs(s, radii, parallel).filter(|g| g.0 <= 0.0);
     }
     let grid = super::cells::CellGrid::build(&s.x[..n], &s.y[..n], &s.z[..n], reach);
     let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
