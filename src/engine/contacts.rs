@@ -87,6 +87,25 @@ impl Steric {
         Ok(Steric { range, stiffness })
     }
 
+    /// The repulsion on sphere `i` from sphere `j`, if they are within reach.
+    #[inline]
+    fn pair_force(
+        &self,
+        pos: &[Vector3<f64>],
+        radii: &[f64],
+        i: usize,
+        j: usize,
+    ) -> Option<Vector3<f64>> {
+        let r = pos[i] - pos[j];
+        // Compare squares first: the square root is taken for the few close pairs only.
+        let reach = self.range + radii[i] + radii[j];
+        let d2 = r.norm_squared();
+        (d2 < reach * reach && d2 > 0.0).then(|| {
+            let d = d2.sqrt();
+            r * (self.stiffness * (reach - d) / d)
+        })
+    }
+
     /// Adds the repulsion on every sphere to `forces`. Sphere α belongs to swimmer α/2; spheres of
     /// one swimmer do not repel. Each row sums its own partners in index order (no scatter), so
     /// rows run in parallel when `parallel` with results independent of the thread count.
@@ -98,17 +117,11 @@ impl Steric {
         parallel: bool,
     ) {
         let row = |i: usize, f: &mut Vector3<f64>| {
-            for (j, (pj, aj)) in pos.iter().zip(radii).enumerate() {
-                if j / 2 == i / 2 {
-                    continue;
-                }
-                let r = pos[i] - pj;
-                // Compare squares first: the square root is taken for the few close pairs only.
-                let reach = self.range + radii[i] + aj;
-                let d2 = r.norm_squared();
-                if d2 < reach * reach && d2 > 0.0 {
-                    let d = d2.sqrt();
-                    *f += r * (self.stiffness * (reach - d) / d);
+            for j in 0..pos.len() {
+                if j / 2 != i / 2 {
+                    if let Some(df) = self.pair_force(pos, radii, i, j) {
+                        *f += df;
+                    }
                 }
             }
         };
@@ -145,15 +158,10 @@ impl Steric {
             for (a, b) in runs {
                 for &j in &grid.order[a as usize..b as usize] {
                     let j = j as usize;
-                    if j / 2 == i / 2 {
-                        continue;
-                    }
-                    let r = pos[i] - pos[j];
-                    let reach = self.range + radii[i] + radii[j];
-                    let d2 = r.norm_squared();
-                    if d2 < reach * reach && d2 > 0.0 {
-                        let d = d2.sqrt();
-                        close.push((j, r * (self.stiffness * (reach - d) / d)));
+                    if j / 2 != i / 2 {
+                        if let Some(df) = self.pair_force(pos, radii, i, j) {
+                            close.push((j, df));
+                        }
                     }
                 }
             }

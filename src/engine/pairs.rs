@@ -285,41 +285,7 @@ fn min_gap_by_cells(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f6
     if !(side > 0.0 && side.is_finite()) {
         return None;
     }
-    let grid = super::cells::CellGrid::build(&s.x[..n], &s.y[..n], &s.z[..n], side);
-    let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
-        if (b.0, b.1, b.2) < (a.0, a.1, a.2) {
-            b
-        } else {
-            a
-        }
-    };
-    let row = |i: usize| -> Option<(f64, usize, usize)> {
-        let mut runs = Vec::with_capacity(27);
-        grid.neighbour_runs(s.x[i], s.y[i], s.z[i], &mut runs);
-        let mut best: Option<(f64, usize, usize)> = None;
-        for (a, b) in runs {
-            for &j in &grid.order[a as usize..b as usize] {
-                let j = j as usize;
-                if j <= i {
-                    continue;
-                }
-                let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
-                let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
-                best = Some(best.map_or((gap, i, j), |x| first(x, (gap, i, j))));
-            }
-        }
-        best
-    };
-    let pick = |a: Option<(f64, usize, usize)>, b: Option<(f64, usize, usize)>| match (a, b) {
-        (Some(x), Some(y)) => Some(first(x, y)),
-        (x, None) => x,
-        (None, y) => y,
-    };
-    let found = if parallel {
-        (0..n).into_par_iter().map(row).reduce(|| None, pick)
-    } else {
-        (0..n).map(row).fold(None, pick)
-    }?;
+    let found = closest_in_cells(s, radii, side, parallel, |_| true)?;
     (found.0 + 2.0 * a_max < side).then_some(found)
 }
 
@@ -369,7 +335,21 @@ pub fn closest_overlap(
     if n < CELL_LIST_SPHERES || !(reach > 0.0 && reach.is_finite()) {
         return min_gap_all_pairs(s, radii, parallel).filter(|g| g.0 <= 0.0);
     }
-    let grid = super::cells::CellGrid::build(&s.x[..n], &s.y[..n], &s.z[..n], reach);
+    closest_in_cells(s, radii, reach, parallel, |gap| gap <= 0.0)
+}
+
+/// The pair (i < j) of smallest gap, then smallest i, then smallest j, among the pairs in
+/// neighbouring cells of side `side` whose gap `keep` accepts: every pair closer than `side` is
+/// among them.
+fn closest_in_cells(
+    s: &SoaSpheres,
+    radii: &[f64],
+    side: f64,
+    parallel: bool,
+    keep: impl Fn(f64) -> bool + Sync,
+) -> Option<(f64, usize, usize)> {
+    let n = s.len();
+    let grid = super::cells::CellGrid::build(&s.x[..n], &s.y[..n], &s.z[..n], side);
     let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
         if (b.0, b.1, b.2) < (a.0, a.1, a.2) {
             b
@@ -389,7 +369,7 @@ pub fn closest_overlap(
                 }
                 let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
                 let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
-                if gap <= 0.0 {
+                if keep(gap) {
                     best = Some(best.map_or((gap, i, j), |x| first(x, (gap, i, j))));
                 }
             }
