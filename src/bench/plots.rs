@@ -75,8 +75,11 @@ pub fn backends(rows: &[BackendRow]) -> Figure {
 /// Cost per period against the number of swimmers, both models, with the fitted power laws.
 pub fn scaling(rows: &[ScalingRow]) -> Figure {
     let mut series = Vec::new();
-    for (k, model) in [Model::Micro, Model::Averaged].into_iter().enumerate() {
-        let mine: Vec<&ScalingRow> = rows.iter().filter(|r| r.model == model).collect();
+    for (k, (model, cutoff)) in scaling::series().into_iter().enumerate() {
+        let mine: Vec<&ScalingRow> = rows
+            .iter()
+            .filter(|r| r.model == model && r.cutoff == cutoff)
+            .collect();
         if mine.is_empty() {
             continue;
         }
@@ -85,12 +88,12 @@ pub fn scaling(rows: &[ScalingRow]) -> Figure {
             .map(|r| (r.swimmers as f64, r.per_period()))
             .collect();
         series.push(Series::from_points(
-            model.name(),
+            scaling::label(model, cutoff),
             &measured,
             Style::Points,
             Some(k),
         ));
-        if let Some((slope, c)) = scaling::fit(rows, model, 256) {
+        if let Some((slope, c)) = scaling::fit(rows, model, cutoff, 256) {
             let fitted: Vec<(f64, f64)> = measured
                 .iter()
                 .map(|&(x, _)| (x, c * x.powf(slope)))

@@ -93,16 +93,16 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
             let rows = scaling::run(if quick { 256 } else { 4096 })?;
             let t = scaling::table(&rows);
             println!(
-                "cost per stroke period on the CPU ({} threads; lattice scenes, RK4: micro at its default step, averaged one step per period):\n{}",
+                "cost per stroke period on the CPU ({} threads; lattice scenes 3 ell apart, RK4: micro at its default step, averaged one step per period; the cutoff series up to 8x larger):\n{}",
                 rayon::current_num_threads(),
                 t.render()
             );
-            for m in [Model::Micro, Model::Averaged] {
+            for (m, cutoff) in scaling::series() {
                 for from in [2, 256] {
-                    if let Some((k, c)) = scaling::fit(&rows, m, from) {
+                    if let Some((k, c)) = scaling::fit(&rows, m, cutoff, from) {
                         println!(
                             "{}: cost per period ~ {c:.2e} s * S^{k:.2} (fit over S >= {from})",
-                            m.name()
+                            scaling::label(m, cutoff)
                         );
                     }
                 }

@@ -1,5 +1,6 @@
 //! Cost per stroke period against the number of swimmers S, for the microscopic and the averaged
-//! model on the CPU, with the exponent of a power-law fit.
+//! model on the CPU, and the averaged model with a far-field cutoff of [`CUTOFF_ELLS`] ℓ (cell
+//! lists: O(S)), with the exponent of a power-law fit.
 //!
 //! Each size is a cubic lattice of Fig-1 swimmers 3ℓ apart (every pair interacts,
 //! [`crate::engine::build::lattice_scene`]). The time per RK4 step is measured
@@ -12,7 +13,7 @@
 
 use super::table::Table;
 use crate::engine::build::lattice_scene;
-use crate::engine::calibrate::step_time;
+use crate::engine::calibrate::step_time_with_cutoff;
 use crate::engine::{Backend, Model};
 
 /// One measured size.
@@ -20,6 +21,8 @@ use crate::engine::{Backend, Model};
 pub struct Row {
     /// Model.
     pub model: Model,
+    /// The averaged model's far-field cutoff (m), if any.
+    pub cutoff: Option<f64>,
     /// Swimmers.
     pub swimmers: usize,
     /// Seconds per RK4 step.
@@ -35,21 +38,46 @@ impl Row {
     }
 }
 
-/// Measure S = 2, 4, … `max` swimmers for both models.
+/// The cutoff of the third series, in ℓ (the lattice is 3ℓ apart: ~150 partners each).
+pub const CUTOFF_ELLS: f64 = 10.0;
+
+/// The series measured: (model, cutoff in m).
+pub fn series() -> [(Model, Option<f64>); 3] {
+    let ell = crate::engine::Dumbbell::default().ell;
+    [
+        (Model::Micro, None),
+        (Model::Averaged, None),
+        (Model::Averaged, Some(CUTOFF_ELLS * ell)),
+    ]
+}
+
+/// A series' label: the model, and its cutoff.
+pub fn label(model: Model, cutoff: Option<f64>) -> String {
+    match cutoff {
+        Some(_) => format!("{}, cutoff {CUTOFF_ELLS} ell", model.name()),
+        None => model.name().to_string(),
+    }
+}
+
+/// Measure S = 2, 4, … `max` swimmers for both models, and up to 8 `max` for the averaged model
+/// with its cutoff.
 pub fn run(max: usize) -> Result<Vec<Row>, String> {
     let mut rows = Vec::new();
-    for model in [Model::Micro, Model::Averaged] {
+    for (model, cutoff) in series() {
+        let top = if cutoff.is_some() { 8 * max } else { max };
         let mut s = 2;
-        while s <= max {
+        while s <= top {
             let scene = lattice_scene(s, model).map_err(|e| e.to_string())?;
             let period = scene.period().map_err(|e| e.to_string())?;
             let steps_per_period = match model {
                 Model::Averaged => 1.0,
                 _ => (period / scene.default_micro_step()).ceil(),
             };
-            let step = step_time(model, Backend::Cpu, s).map_err(|e| e.to_string())?;
+            let step =
+                step_time_with_cutoff(model, Backend::Cpu, s, cutoff).map_err(|e| e.to_string())?;
             rows.push(Row {
                 model,
+                cutoff,
                 swimmers: s,
                 step,
                 steps_per_period,
@@ -60,12 +88,12 @@ pub fn run(max: usize) -> Result<Vec<Row>, String> {
     Ok(rows)
 }
 
-/// Least-squares slope and prefactor of log(cost) against log(S) over rows with S ≥ `from`:
-/// cost ≈ c · S^slope. `None` with fewer than two such rows.
-pub fn fit(rows: &[Row], model: Model, from: usize) -> Option<(f64, f64)> {
+/// Least-squares slope and prefactor of log(cost) against log(S) over the series' rows with
+/// S ≥ `from`: cost ≈ c · S^slope. `None` with fewer than two such rows.
+pub fn fit(rows: &[Row], model: Model, cutoff: Option<f64>, from: usize) -> Option<(f64, f64)> {
     let pts: Vec<(f64, f64)> = rows
         .iter()
-        .filter(|r| r.model == model && r.swimmers >= from)
+        .filter(|r| r.model == model && r.cutoff == cutoff && r.swimmers >= from)
         .map(|r| ((r.swimmers as f64).ln(), r.per_period().ln()))
         .collect();
     if pts.len() < 2 {
@@ -93,7 +121,7 @@ pub fn table(rows: &[Row]) -> Table {
     ]);
     for r in rows {
         t.rows.push(vec![
-            r.model.name().into(),
+            label(r.model, r.cutoff),
             r.swimmers.to_string(),
             format!("{:.3e}", r.step),
             format!("{:.0}", r.steps_per_period),

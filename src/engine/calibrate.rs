@@ -155,7 +155,18 @@ const CALIBRATION_BUDGET: f64 = 0.02;
 /// Wall time per RK4 step of a cubic lattice of `swimmers` Fig-1 swimmers on one backend (`auto`
 /// is timed on the GPU: this measures the backends, it does not choose between them).
 pub fn step_time(model: Model, backend: Backend, swimmers: usize) -> Result<f64> {
+    step_time_with_cutoff(model, backend, swimmers, None)
+}
+
+/// [`step_time`] of the lattice with the averaged model's far-field cutoff `cutoff` (m).
+pub fn step_time_with_cutoff(
+    model: Model,
+    backend: Backend,
+    swimmers: usize,
+    cutoff: Option<f64>,
+) -> Result<f64> {
     let mut s = lattice_scene(swimmers, model)?;
+    s.set_cutoff(cutoff)?;
     s.set_backend(backend);
     let dt = s.default_micro_step();
     s.set_integrator(Some(IntegratorSpec::rk4(dt)?));
