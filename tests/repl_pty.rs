@@ -53,8 +53,10 @@ fn transcript_of_a_session() {
     let rec = "let rec = s.record([pair_mean(0, 1)], 1);";
     step(&mut s, rec, "");
     // Ctrl-C during a long run stops it at a step boundary and keeps the scene and the rows.
+    // The progress bar (shown once a run has lasted half a second) says the run has begun: a
+    // Ctrl-C before it would be cleared with the command's start on a slow machine.
     s.send_line("s.run_periods(1000000);").unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
+    s.expect("periods/s").expect("the run has begun");
     s.send(ControlCode::EndOfText).unwrap();
     s.expect("run interrupted at t =").unwrap();
     s.expect(PROMPT).unwrap();

@@ -288,3 +288,28 @@ fn auto_says_what_it_chose_and_why() {
     b.run_periods(300.0).unwrap();
     assert_eq!(a.raw_state().0, b.raw_state().0);
 }
+
+#[test]
+fn a_changed_scene_gets_a_stepper_of_its_own() {
+    // After 20 periods a third swimmer with omega = 750 1/s joins: the common period doubles.
+    // The next run must sample the new period, as a fresh simulation of the same scene does.
+    let mut s = fig1_pair(Some(IntegratorSpec::stroboscopic(1e-4).unwrap()));
+    s.run_periods(20.0).unwrap();
+    let d = Dumbbell {
+        omega: 750.0,
+        ..*s.swimmer(0).unwrap()
+    };
+    s.scene_mut()
+        .add(
+            d,
+            nalgebra::Vector3::new(0.0, 60e-6, 0.0),
+            nalgebra::Vector3::y(),
+        )
+        .unwrap();
+    let t = s.common_period().unwrap();
+    assert!((t - 2.0 * s.swimmer(0).unwrap().period()).abs() < 1e-15);
+    let mut fresh = Simulation::new(s.scene().clone());
+    s.run(40.0 * t).unwrap();
+    fresh.run(40.0 * t).unwrap();
+    assert_eq!(s.raw_state().0, fresh.raw_state().0);
+}

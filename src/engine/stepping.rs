@@ -81,14 +81,15 @@ impl RunControl {
 /// the device buffers of the last GPU run, reused while the scene's size and method stay.
 #[derive(Default)]
 pub struct Workspace {
-    stepper: Option<(IntegratorSpec, Box<dyn Stepper>)>,
+    /// The stepper, with the spec and the scene key ([`Scene::stepper_key`]) it was built for.
+    stepper: Option<(IntegratorSpec, Vec<u64>, Box<dyn Stepper>)>,
     gpu: Option<GpuRun>,
 }
 
 impl std::fmt::Debug for Workspace {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Workspace")
-            .field("stepper", &self.stepper.as_ref().map(|(spec, _)| spec))
+            .field("stepper", &self.stepper.as_ref().map(|(spec, ..)| spec))
             .field("gpu", &self.gpu.is_some())
             .finish()
     }
@@ -112,8 +113,9 @@ pub fn advance_cpu(
 ) -> Result<()> {
     let mut sys = s.system()?;
     let spec = s.integrator();
+    let key = s.stepper_key(spec);
     let mut stepper = match ws.stepper.take() {
-        Some((cached, mut st)) if cached == spec => {
+        Some((cached, cached_key, mut st)) if cached == spec && cached_key == key => {
             st.reset();
             st
         }
@@ -151,7 +153,7 @@ pub fn advance_cpu(
             }
         }
     }
-    ws.stepper = Some((spec, stepper));
+    ws.stepper = Some((spec, key, stepper));
     outcome
 }
 

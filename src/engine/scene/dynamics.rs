@@ -120,6 +120,22 @@ pub const STIFF_STEPS_PER_PERIOD: f64 = 2e4;
 const RELAXED_E_FOLDINGS: f64 = 37.0;
 
 impl Scene {
+    /// What a stepper for `spec` was built from besides the spec: a cached one is reused only
+    /// while this stays. Direct methods take nothing from the scene; stroboscopic averaging and
+    /// `auto` take the swimmers' count, the model, μ, the common period and the RK4 step.
+    pub(crate) fn stepper_key(&self, spec: IntegratorSpec) -> Vec<u64> {
+        match spec {
+            IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => vec![
+                self.count() as u64,
+                self.model as u64,
+                self.mu.to_bits(),
+                self.common_period().map_or(0, f64::to_bits),
+                self.default_micro_step().to_bits(),
+            ],
+            _ => Vec::new(),
+        }
+    }
+
     /// A fresh stepper for `spec` on this scene. Stroboscopic averaging needs the common period,
     /// the slowest spring relaxation (how many periods relax the fast motion) and a length scale.
     pub(crate) fn stepper(&self, spec: IntegratorSpec) -> Result<Box<dyn Stepper>> {
