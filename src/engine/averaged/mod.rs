@@ -10,10 +10,12 @@
 //! What a scene does not need is skipped: pairs with sin(φσ−φρ) = 0, the I and K terms of symmetric
 //! swimmers, and for an aligned scene the 3D algebra (the 1D reduction e:stroke_averaged).
 //!
-//! Why one file of ~520 lines: the terms, their shortcuts, the row loop over structure-of-arrays
+//! Why one file of ~630 lines (the vector-lane rows apart, in `lanes`): the terms, their shortcuts, the row loop over structure-of-arrays
 //! and its cutoff and contact guard form one right-hand side whose parts are checked against one
 //! another (tests/averaged_model.rs compares every shortcut with the general 3D sum); split, each
 //! piece would need the others' private layout.
+
+mod lanes;
 
 use super::cells::CellGrid;
 use super::contacts::Contacts;
@@ -127,9 +129,10 @@ struct Soa {
 
 /// The stroke-averaged right-hand side.
 ///
-/// Every row σ sums over all ρ in index order (sin(φσ − φρ) from the stored sin φ and cos φ, so no
-/// pair list is kept: memory is O(S)), rows run in parallel from [`PARALLEL_SWIMMERS`] on, and a
-/// row's sum does not depend on the thread count. Nothing is allocated per call.
+/// Every row σ sums over all ρ (sin(φσ − φρ) from the stored sin φ and cos φ, so no pair list is
+/// kept: memory is O(S)): in index order below [`LANE_SWIMMERS`], in 8 vector lanes from there
+/// ([`lanes`]), through cell lists for a cutoff from [`CELL_LIST_SWIMMERS`]. Rows run in parallel
+/// from [`PARALLEL_SWIMMERS`] on, and a row's sum does not depend on the thread count.
 ///
 /// Far-field cutoff ([`AveragedSystem::set_cutoff`], off by default): pairs further apart than D_c
 /// are left out. Each term of a pair at distance D ≥ D_c is bounded with |sin| ≤ 1 and every
@@ -174,7 +177,13 @@ pub struct AveragedSystem {
     cell_phase: Vec<(f64, f64)>,
     /// Use cell lists: `None` decides by size ([`CELL_LIST_SWIMMERS`]).
     cells: Option<bool>,
+    /// Sum all-pairs rows in vector lanes: `None` decides by size ([`LANE_SWIMMERS`]).
+    lanes: Option<bool>,
 }
+
+/// From this many swimmers the all-pairs rows are summed in vector lanes ([`lanes`]); below it
+/// the scalar rows, whose sums are in index order.
+pub const LANE_SWIMMERS: usize = 256;
 
 /// From this many swimmers a cutoff's pairs are found through cell lists: below it the all-pairs
 /// loop is as fast. The two differ only by the rounding of the sums' order ([`super::cells`]).
@@ -233,6 +242,7 @@ impl AveragedSystem {
             mu: super::model::DEFAULT_MU,
             grid: None,
             cells: None,
+            lanes: None,
             cell_soa: Soa::default(),
             cell_phase: Vec::new(),
         };
@@ -272,8 +282,14 @@ impl AveragedSystem {
         (v, rel - n * n.dot(&rel))
     }
 
-    /// Force cell lists on or off for the cutoff's pairs (`None`: by size). The results do not
-    /// depend on it.
+    /// Force the vector-lane rows on or off (`None`: by size). They equal the scalar rows to the
+    /// rounding of the summation order.
+    pub fn set_vector_rows(&mut self, on: Option<bool>) {
+        self.lanes = on;
+    }
+
+    /// Force cell lists on or off for the cutoff's pairs (`None`: by size). They equal the
+    /// all-pairs rows to the rounding of the summation order.
     pub fn set_cell_lists(&mut self, on: Option<bool>) {
         self.cells = on;
     }
@@ -460,7 +476,13 @@ impl AveragedSystem {
                 out[3..6].fill(0.0);
                 return;
             }
-            let (mut v, t) = self.row(s);
+            let vector =
+                self.grid.is_none() && self.lanes.unwrap_or(self.coef.len() >= LANE_SWIMMERS);
+            let (mut v, t) = if vector {
+                lanes::row(self, s)
+            } else {
+                self.row(s)
+            };
             let n = vec3(y, STATE_PER_SWIMMER * s + 3);
             let mut dn = -(t - n * n.dot(&t));
             if self.contacts.steric.is_some() {
