@@ -10,10 +10,11 @@
 //! What a scene does not need is skipped: pairs with sin(φσ−φρ) = 0, the I and K terms of symmetric
 //! swimmers, and for an aligned scene the 3D algebra (the 1D reduction e:stroke_averaged).
 //!
-//! Why one file of ~630 lines (the vector-lane rows apart, in `lanes`): the terms, their shortcuts, the row loop over structure-of-arrays
-//! and its cutoff and contact guard form one right-hand side whose parts are checked against one
-//! another (tests/averaged_model.rs compares every shortcut with the general 3D sum); split, each
-//! piece would need the others' private layout.
+//! Why one file of ~630 lines (the vector-lane rows apart, in `lanes`): the terms, their
+//! shortcuts, the row loop over structure-of-arrays and its cutoff and contact guard form one
+//! right-hand side whose parts are checked against one another (tests/averaged_model.rs compares
+//! every shortcut with the general 3D sum); split, each piece would need the others' private
+//! layout.
 
 mod lanes;
 
