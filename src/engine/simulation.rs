@@ -67,11 +67,6 @@ impl Simulation {
         self.scene
     }
 
-    /// The run control: how runs are stopped and whom they tell the time.
-    pub fn control(&self) -> &RunControl {
-        &self.control
-    }
-
     /// Stop runs (and probes) at a step boundary when `interrupt()` says so (`None`: never).
     pub fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
         self.control.set_interrupt(interrupt);

@@ -37,14 +37,6 @@ impl std::fmt::Debug for RunControl {
 }
 
 impl RunControl {
-    /// A control that stops a run when `interrupt()` says so.
-    pub fn interruptible(interrupt: Interrupt) -> Self {
-        RunControl {
-            interrupt: Some(interrupt),
-            progress: None,
-        }
-    }
-
     /// Stop runs when `interrupt()` says so (`None`: never).
     pub fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
         self.interrupt = interrupt;

@@ -528,21 +528,25 @@ impl OdeSystem for AveragedSystem {
                     CellGrid::build(&self.soa.x, &self.soa.y, &self.soa.z, self.cutoff2.sqrt())
                 });
                 if let Some(g) = &self.grid {
-                    let soa = &self.soa;
-                    let pick = |v: &[f64]| g.order.iter().map(|&i| v[i as usize]).collect();
-                    self.cell_soa = Soa {
-                        x: pick(&soa.x),
-                        y: pick(&soa.y),
-                        z: pick(&soa.z),
-                        nx: pick(&soa.nx),
-                        ny: pick(&soa.ny),
-                        nz: pick(&soa.nz),
-                    };
-                    self.cell_phase = g
-                        .order
-                        .iter()
-                        .map(|&i| (self.sin_phi[i as usize], self.cos_phi[i as usize]))
-                        .collect();
+                    // Refilled in place: the buffers are allocated once, not per right-hand side.
+                    let (soa, cell) = (&self.soa, &mut self.cell_soa);
+                    for (to, from) in [
+                        (&mut cell.x, &soa.x),
+                        (&mut cell.y, &soa.y),
+                        (&mut cell.z, &soa.z),
+                        (&mut cell.nx, &soa.nx),
+                        (&mut cell.ny, &soa.ny),
+                        (&mut cell.nz, &soa.nz),
+                    ] {
+                        to.clear();
+                        to.extend(g.order.iter().map(|&i| from[i as usize]));
+                    }
+                    self.cell_phase.clear();
+                    self.cell_phase.extend(
+                        g.order
+                            .iter()
+                            .map(|&i| (self.sin_phi[i as usize], self.cos_phi[i as usize])),
+                    );
                 }
             }
         }

@@ -115,68 +115,68 @@ pub struct Method {
     pub make: fn(f64) -> Result<IntegratorSpec>,
 }
 
+const EULER: Method = Method {
+    name: "euler",
+    parameter: "dt",
+    parameter_about: "the step in s",
+    about: "forward Euler, fixed step",
+    make: IntegratorSpec::euler,
+};
+
+const RK4: Method = Method {
+    name: "rk4",
+    parameter: "dt",
+    parameter_about: "the step in s",
+    about: "classic Runge-Kutta, fixed step",
+    make: IntegratorSpec::rk4,
+};
+
+const DOPRI5: Method = Method {
+    name: "dopri5",
+    parameter: "rtol",
+    parameter_about: "the relative tolerance",
+    about: "adaptive Dormand-Prince 5(4)",
+    make: IntegratorSpec::dopri5,
+};
+
+const STROBOSCOPIC: Method = Method {
+    name: "stroboscopic",
+    parameter: "tol",
+    parameter_about: "the tolerance relative to the drift",
+    about: "stroboscopic averaging: macro steps of many periods (spring and rigid models)",
+    make: IntegratorSpec::stroboscopic,
+};
+
+const AUTO: Method = Method {
+    name: "auto",
+    parameter: "tol",
+    parameter_about: "the tolerance relative to the drift",
+    about: "the cheapest method expected to meet tol for the scene (s.integrator_info says which)",
+    make: IntegratorSpec::auto,
+};
+
+const ROSW: Method = Method {
+    name: "rosw",
+    parameter: "rtol",
+    parameter_about: "the relative tolerance",
+    about: "adaptive Rosenbrock-W ROS34PW2, for stiff springs",
+    make: IntegratorSpec::rosw,
+};
+
 /// Every method, in the order messages list them.
-pub const METHODS: &[Method] = &[
-    Method {
-        name: "euler",
-        parameter: "dt",
-        parameter_about: "the step in s",
-        about: "forward Euler, fixed step",
-        make: IntegratorSpec::euler,
-    },
-    Method {
-        name: "rk4",
-        parameter: "dt",
-        parameter_about: "the step in s",
-        about: "classic Runge-Kutta, fixed step",
-        make: IntegratorSpec::rk4,
-    },
-    Method {
-        name: "dopri5",
-        parameter: "rtol",
-        parameter_about: "the relative tolerance",
-        about: "adaptive Dormand-Prince 5(4)",
-        make: IntegratorSpec::dopri5,
-    },
-    Method {
-        name: "stroboscopic",
-        parameter: "tol",
-        parameter_about: "the tolerance relative to the drift",
-        about: "stroboscopic averaging: macro steps of many periods (spring and rigid models)",
-        make: IntegratorSpec::stroboscopic,
-    },
-    Method {
-        name: "auto",
-        parameter: "tol",
-        parameter_about: "the tolerance relative to the drift",
-        about:
-            "the cheapest method expected to meet tol for the scene (s.integrator_info says which)",
-        make: IntegratorSpec::auto,
-    },
-    Method {
-        name: "rosw",
-        parameter: "rtol",
-        parameter_about: "the relative tolerance",
-        about: "adaptive Rosenbrock-W ROS34PW2, for stiff springs",
-        make: IntegratorSpec::rosw,
-    },
-];
+pub const METHODS: &[Method] = &[EULER, RK4, DOPRI5, STROBOSCOPIC, AUTO, ROSW];
 
 impl IntegratorSpec {
     /// The method's entry in [`METHODS`].
     pub fn method(&self) -> &'static Method {
-        let name = match self {
-            IntegratorSpec::Euler { .. } => "euler",
-            IntegratorSpec::Rk4 { .. } => "rk4",
-            IntegratorSpec::Dopri5 { .. } => "dopri5",
-            IntegratorSpec::Rosw { .. } => "rosw",
-            IntegratorSpec::Stroboscopic { .. } => "stroboscopic",
-            IntegratorSpec::Auto { .. } => "auto",
-        };
-        METHODS
-            .iter()
-            .find(|m| m.name == name)
-            .expect("every method has an entry in METHODS")
+        match self {
+            IntegratorSpec::Euler { .. } => &EULER,
+            IntegratorSpec::Rk4 { .. } => &RK4,
+            IntegratorSpec::Dopri5 { .. } => &DOPRI5,
+            IntegratorSpec::Rosw { .. } => &ROSW,
+            IntegratorSpec::Stroboscopic { .. } => &STROBOSCOPIC,
+            IntegratorSpec::Auto { .. } => &AUTO,
+        }
     }
 
     /// The one parameter's value: the step (s) or the tolerance.
@@ -240,26 +240,38 @@ impl IntegratorSpec {
     }
 }
 
-/// A tolerance relative to the drift: 1e-10 ≤ tol < 1.
+/// A tolerance relative to the drift: 1e-10 ≤ tol < 1 (below, the samples' round-off is larger
+/// than what is asked).
 fn check_drift_tol(method: &str, tol: f64) -> Result<f64> {
-    require_positive(&format!("{method}(tol): tol"), tol, "dimensionless")?;
-    if !(1e-10..1.0).contains(&tol) {
-        return Err(invalid!(
-            "{method}(tol): tol must lie in [1e-10, 1) (below 1e-10 the samples' round-off is larger than what is asked), got {tol:e}"
-        ));
-    }
-    Ok(tol)
+    check_tolerance(
+        method,
+        "tol",
+        tol,
+        1e-10,
+        "the samples' round-off is larger than what is asked",
+    )
 }
 
 /// An adaptive method's tolerance: 1e-14 ≤ rtol < 1.
 fn check_rtol(method: &str, rtol: f64) -> Result<f64> {
-    require_positive(&format!("{method}(rtol): rtol"), rtol, "dimensionless")?;
-    if !(1e-14..1.0).contains(&rtol) {
+    check_tolerance(
+        method,
+        "rtol",
+        rtol,
+        1e-14,
+        "the error estimate is round-off",
+    )
+}
+
+/// `method(name)`'s tolerance `value`, positive, in [min, 1); `why` says what fails below min.
+fn check_tolerance(method: &str, name: &str, value: f64, min: f64, why: &str) -> Result<f64> {
+    require_positive(&format!("{method}({name}): {name}"), value, "dimensionless")?;
+    if !(min..1.0).contains(&value) {
         return Err(invalid!(
-            "{method}(rtol): rtol must lie in [1e-14, 1) (below 1e-14 the error estimate is round-off), got {rtol:e}"
+            "{method}({name}): {name} must lie in [{min:e}, 1) (below {min:e} {why}), got {value:e}"
         ));
     }
-    Ok(rtol)
+    Ok(value)
 }
 
 impl fmt::Display for IntegratorSpec {
