@@ -56,4 +56,5 @@ fn help_lists_every_choice_as_the_engine_defines_it() {
     check::<Backend>("backend");
     check::<Coefficients>("coefficients");
     check::<Overlaps>("overlaps");
+    check::<swimlab::engine::thermal::NoiseRoot>("noise_root");
 }

@@ -37,7 +37,10 @@ pub fn check_steps(s: &Scene, t_end: f64) -> Result<()> {
     if t_end <= s.time() {
         return Ok(());
     }
-    if let IntegratorSpec::Euler { dt } | IntegratorSpec::Rk4 { dt } = s.integrator() {
+    if let IntegratorSpec::Euler { dt }
+    | IntegratorSpec::Rk4 { dt }
+    | IntegratorSpec::Platen { dt } = s.integrator()
+    {
         let scale = s.time().abs().max(t_end.abs());
         require_resolvable(
             &format!("the step dt = {dt:e} s"),

@@ -49,6 +49,9 @@ pub fn gpu_tableau(spec: &IntegratorSpec) -> std::result::Result<(f64, Tableau),
     match *spec {
         IntegratorSpec::Euler { dt } => Ok((dt, Tableau::euler())),
         IntegratorSpec::Rk4 { dt } => Ok((dt, Tableau::rk4())),
+        IntegratorSpec::Platen { .. } => Err(format!(
+            "the GPU backend steps the fixed-step methods euler(dt) and rk4(dt); {spec}, the weak scheme for thermal noise, runs on the CPU"
+        )),
         other => Err(format!(
             "the GPU backend steps the fixed-step methods euler(dt) and rk4(dt); {other} is adaptive and runs on the CPU"
         )),

@@ -27,6 +27,12 @@ pub enum Setting {
     AddSwimmer,
     /// Swimmers placed on a lattice instead of at random.
     Lattice,
+    /// Use this mobility ("rpy", "oseen").
+    Mobility(&'static str),
+    /// Temperature 0: no thermal noise.
+    NoNoise,
+    /// A scheme for thermal noise: Euler-Maruyama or Platen's weak second-order scheme.
+    NoiseIntegrator,
 }
 
 impl std::fmt::Display for Setting {
@@ -47,6 +53,11 @@ impl std::fmt::Display for Setting {
             Setting::NoCutoff => f.write_str("no cutoff (every pair)"),
             Setting::AddSwimmer => f.write_str("adding a swimmer"),
             Setting::Lattice => f.write_str("swimmers placed on a lattice"),
+            Setting::Mobility(m) => write!(f, "the {m} mobility"),
+            Setting::NoNoise => f.write_str("temperature 0 (no thermal noise)"),
+            Setting::NoiseIntegrator => f.write_str(
+                "a scheme for thermal noise: euler (Euler-Maruyama) or platen (weak order 2) with a step dt",
+            ),
         }
     }
 }

@@ -8,12 +8,13 @@
 //! - db/dt = −f (1/γ₁ + 1/γ₂) + u₂ − u₁, γ = 6πμa.
 
 use super::contacts::Contacts;
-use super::integrators::{OdeSystem, Problem};
+use super::integrators::{Noise, OdeSystem, Problem};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
-use nalgebra::Vector3;
+use super::thermal::{lanczos, Thermal};
+use nalgebra::{DMatrix, Vector3};
 
 /// The microscopic right-hand side with its scratch buffers.
 #[derive(Debug, Clone)]
@@ -21,6 +22,10 @@ pub struct MicroSystem {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
     spheres: Spheres,
+    /// Thermal noise, if the temperature is above 0.
+    thermal: Option<Thermal>,
+    /// Sphere displacements of one step's noise (scratch, 3 per sphere).
+    kicks: Vec<f64>,
 }
 
 impl MicroSystem {
@@ -36,9 +41,47 @@ impl MicroSystem {
             swimmers: swimmers.to_vec(),
             base: base.to_vec(),
             spheres: Spheres::new(swimmers, mu, mobility, contacts),
+            thermal: None,
+            kicks: Vec::new(),
         }
     }
 
+    /// Thermal noise at `thermal`'s temperature (none at 0 K).
+    pub fn set_thermal(&mut self, thermal: Thermal) {
+        self.thermal = thermal.is_on().then_some(thermal);
+    }
+
+    /// The full mobility matrix at the current sphere positions and its Cholesky factor L.
+    fn mobility_factor(&self) -> Result<DMatrix<f64>, Problem> {
+        let sp = &self.spheres;
+        let m = sp.mobility.matrix(sp.mu, &sp.pos, &sp.radii);
+        m.cholesky().map(|c| c.unpack()).ok_or_else(not_positive)
+    }
+
+    /// Sphere displacements (flat, 3 per sphere) into state increments added to `out`:
+    /// ΔR_H = w1 Δx₁ + w2 Δx₂, Δb = Δx₂ − Δx₁, each scaled by `scale`.
+    fn add_to_state(&self, dx: impl Fn(usize) -> f64, scale: f64, out: &mut [f64]) {
+        for (s, d) in self.swimmers.iter().enumerate() {
+            for k in 0..3 {
+                let (x1, x2) = (dx(6 * s + k), dx(6 * s + 3 + k));
+                out[STATE_PER_SWIMMER * s + k] += scale * (d.w1() * x1 + d.w2() * x2);
+                out[STATE_PER_SWIMMER * s + 3 + k] += scale * (x2 - x1);
+            }
+        }
+    }
+}
+
+/// The mobility matrix has no Cholesky factor or square root.
+fn not_positive() -> Problem {
+    Problem {
+        swimmer: None,
+        cause: "the mobility matrix is not positive definite here, so thermal noise has no square root (the Oseen tensor loses definiteness when spheres come within about 1.5 radii)".into(),
+        hint: "use the rpy mobility, which stays positive definite for any positions".into(),
+        fixes: vec![crate::engine::error::Setting::Mobility("rpy")],
+    }
+}
+
+impl MicroSystem {
     /// Place the spheres at the state `y`.
     fn place(&mut self, y: &[f64]) {
         for (s, d) in self.swimmers.iter().enumerate() {
@@ -122,6 +165,75 @@ impl OdeSystem for MicroSystem {
             scale[i..i + 3].fill(d.drift_scale());
             scale[i + 3..i + 6].fill(d.stroke_scale());
         }
+    }
+
+    fn noise(&self) -> Option<Noise> {
+        self.thermal.map(|th| Noise {
+            seed: th.seed,
+            dim: 6 * self.swimmers.len(),
+        })
+    }
+
+    /// The spheres move by √(2kT)·B·dw with B Bᵀ = M: B the Cholesky factor, or √M through the
+    /// Lanczos iteration on the pair kernel (large scenes, see [`Thermal::root`]).
+    fn add_noise(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        dw: &[f64],
+        y_new: &mut [f64],
+    ) -> Result<(), Problem> {
+        let Some(th) = self.thermal else {
+            return Ok(());
+        };
+        self.place(y);
+        let scale = (2.0 * th.kt()).sqrt();
+        let n = dw.len();
+        if th.root.dense_for(self.spheres.pos.len()) {
+            let l = self.mobility_factor()?;
+            let dx = l * nalgebra::DVector::from_column_slice(dw);
+            self.add_to_state(|i| dx[i], scale, y_new);
+            return Ok(());
+        }
+        let mut kicks = std::mem::take(&mut self.kicks);
+        kicks.resize(n, 0.0);
+        let spheres = &mut self.spheres;
+        let mut apply = |v: &[f64], out: &mut [f64]| spheres.apply_mobility(v, out);
+        let outcome = lanczos::sqrt_times(&mut apply, dw, th.lanczos_tol, &mut kicks);
+        let result = match outcome {
+            Ok(_) => {
+                self.add_to_state(|i| kicks[i], scale, y_new);
+                Ok(())
+            }
+            Err(lanczos::LanczosFailure::NotPositive(_)) => Err(not_positive()),
+            Err(lanczos::LanczosFailure::NoConvergence { steps, change }) => Err(Problem {
+                swimmer: None,
+                cause: format!("the Lanczos square root of the mobility did not converge in {steps} steps (last change {change:.1e})"),
+                hint: "loosen the Lanczos tolerance, or take the Cholesky noise root on a small scene".into(),
+                fixes: Vec::new(),
+            }),
+        };
+        self.kicks = kicks;
+        result
+    }
+
+    /// √(2kT)·T·L: the Cholesky factor L of M mapped to the state (R_H and b of each dumbbell).
+    fn diffusion(&mut self, _t: f64, y: &[f64], b: &mut DMatrix<f64>) -> Result<(), Problem> {
+        let Some(th) = self.thermal else {
+            b.fill(0.0);
+            return Ok(());
+        };
+        self.place(y);
+        let l = self.mobility_factor()?;
+        let scale = (2.0 * th.kt()).sqrt();
+        b.fill(0.0);
+        for col in 0..l.ncols() {
+            let mut column = b.column_mut(col);
+            let mut tmp = vec![0.0; column.len()];
+            self.add_to_state(|i| l[(i, col)], scale, &mut tmp);
+            column.copy_from_slice(&tmp);
+        }
+        Ok(())
     }
 
     /// Rejects overlapping spheres, and springs stretched or compressed by more than half a body

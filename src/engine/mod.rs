@@ -30,6 +30,7 @@ pub mod simulation;
 mod spheres;
 pub mod stepping;
 pub mod swimmer;
+pub mod thermal;
 
 pub use backend::Backend;
 pub use contacts::{Contacts, Overlaps, Steric};

@@ -42,6 +42,12 @@ pub enum Observable {
     /// Mean swimming speed ⟨|V|⟩ over the swimmers (m/s): V = dR_H/dt in the averaged model, the
     /// displacement of R_H over the next period / T in the sphere models (a probe run on a copy).
     MeanSpeed,
+    /// Mean squared displacement ⟨|R_H(t) − R_H(0)|²⟩ over the swimmers since each was placed (m²).
+    Msd,
+    /// Péclet number of the pair (i, j): the deterministic drift of its mean position over one
+    /// period against the rms diffusion of that mean along one axis in the same time,
+    /// |V| T / √(2 D T), with D = (D_t^i + D_t^j)/4 the mean's coefficient as rigid dumbbells.
+    Peclet(usize, usize),
     /// Histogram of the centre distances D_H of all pairs: `bins` counts, bin k covering
     /// [k, k+1) · r_max/bins (m); pairs at r_max or beyond are not counted.
     PairDistances {
@@ -81,6 +87,8 @@ impl Observable {
             Observable::Nematic => "nematic".into(),
             Observable::MinGap => "min_gap".into(),
             Observable::MeanSpeed => "mean_speed".into(),
+            Observable::Msd => "msd".into(),
+            Observable::Peclet(i, j) => format!("Pe[{i},{j}]"),
             Observable::PairDistances { .. } => "D_H_hist".into(),
         }
     }
@@ -97,6 +105,7 @@ impl Observable {
             | Observable::MinGap => "m",
             Observable::Tension(_) => "N",
             Observable::MeanSpeed => "m/s",
+            Observable::Msd => "m^2",
             Observable::PairDistances { .. } => "pairs",
             Observable::DeltaDistanceH(..) => "ell",
             _ => "1",
@@ -136,8 +145,10 @@ impl Observable {
             | Observable::Q(i, j)
             | Observable::DistanceH(i, j)
             | Observable::DeltaQ(i, j)
-            | Observable::DeltaDistanceH(i, j) => vec![i, j],
+            | Observable::DeltaDistanceH(i, j)
+            | Observable::Peclet(i, j) => vec![i, j],
             Observable::Polarization
+            | Observable::Msd
             | Observable::Nematic
             | Observable::MinGap
             | Observable::MeanSpeed
@@ -229,7 +240,40 @@ impl Observable {
                 vec![v.iter().map(|v| v.norm()).sum::<f64>() / v.len().max(1) as f64]
             }
             Observable::PairDistances { bins, r_max } => Self::histogram(s, bins, r_max)?,
+            Observable::Msd => {
+                let mut sum = 0.0;
+                for i in 0..s.count() {
+                    sum += s.displacement(i)?.norm_squared();
+                }
+                vec![sum / s.count().max(1) as f64]
+            }
+            Observable::Peclet(i, j) => vec![Self::peclet(s, i, j, probe)?],
         })
+    }
+
+    /// The Péclet number of pair (i, j) ([`Observable::Peclet`]): the drift from a probe on a
+    /// noise-free copy with the model's default integrator, the diffusion at the scene's
+    /// temperature.
+    fn peclet(s: &Scene, i: usize, j: usize, probe: &mut Probe) -> Result<f64> {
+        if !s.thermal().is_on() {
+            return Err(super::error::invalid!(
+                "the Peclet number compares drift with diffusion, and at temperature 0 nothing diffuses; set a temperature above 0 K"
+            ));
+        }
+        let mut quiet = s.clone();
+        quiet.set_temperature(0.0)?;
+        quiet.set_integrator(None);
+        if quiet.model() != super::model::Model::Averaged {
+            // A noisy state lies off the stroke's cycle by the thermal spring fluctuation, whose
+            // relaxation moves R_H (the dumbbell's own spheres interact) by far more than a
+            // period's drift: relax for one period first.
+            quiet = probe.one_period_later(&quiet)?;
+        }
+        let v = probe.center_velocities(&quiet)?;
+        let drift = (v[i] + v[j]) / 2.0;
+        let t = s.period()?;
+        let d = (s.rigid_diffusion(i)?.translation() + s.rigid_diffusion(j)?.translation()) / 4.0;
+        Ok(drift.norm() * t / (2.0 * d * t).sqrt())
     }
 
     /// Counts of pair distances D_H in `bins` bins on [0, r_max); rows in parallel for large scenes.

@@ -16,6 +16,7 @@ use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
 use super::rigid::RigidSystem;
 use super::swimmer::{unit_direction, Dumbbell};
+use super::thermal::{NoiseRoot, Thermal};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -29,6 +30,9 @@ pub use save::{MAX_TIME_IN_PERIODS, SAVE_FORMAT};
 /// closes to < 1e-12 ℓ per period (measured 7e-13; at 2.0 it is 6e-11, which would be 5e-5 of the
 /// Fig-1 drift). The error falls as dt⁵ (README, "Accuracy").
 pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
+/// With thermal noise the spring model's default Euler-Maruyama step times the stiffest spring's
+/// relaxation rate: Euler-Maruyama overestimates a spring's length variance kT/k0 by 1/(1 − 0.05).
+pub const DEFAULT_NOISY_STEP_TIMES_RATE: f64 = 0.1;
 /// The default step never exceeds this fraction of the shortest period, so that soft springs
 /// (small k0) still resolve the stroke.
 pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
@@ -84,6 +88,9 @@ pub struct Scene {
     /// Where the dynamics run (saved; "cpu" for files from before backends existed).
     #[serde(default)]
     backend: Backend,
+    /// Temperature and noise seed (saved unless all default, so noise-free files are unchanged).
+    #[serde(default, skip_serializing_if = "Thermal::is_default")]
+    thermal: Thermal,
 }
 
 impl Default for Scene {
@@ -102,6 +109,7 @@ impl Default for Scene {
             time: 0.0,
             stats: Stats::default(),
             backend: Backend::default(),
+            thermal: Thermal::default(),
         }
     }
 }
@@ -283,6 +291,33 @@ impl Scene {
         Ok(())
     }
 
+    /// Temperature, noise seed and how the noise's square root is taken.
+    pub fn thermal(&self) -> Thermal {
+        self.thermal
+    }
+
+    /// Set the temperature (K); 0 turns thermal noise off.
+    pub fn set_temperature(&mut self, kelvin: f64) -> Result<()> {
+        self.thermal.temperature = Thermal::check_temperature(kelvin)?;
+        Ok(())
+    }
+
+    /// Seed the noise: runs from the same state and seed draw the same noise.
+    pub fn set_seed(&mut self, seed: u64) {
+        self.thermal.seed = seed;
+    }
+
+    /// How √M·ξ is computed: dense Cholesky, Lanczos, or by size.
+    pub fn set_noise_root(&mut self, root: NoiseRoot) {
+        self.thermal.root = root;
+    }
+
+    /// The Lanczos iteration's tolerance.
+    pub fn set_lanczos_tol(&mut self, tol: f64) -> Result<()> {
+        self.thermal.lanczos_tol = Thermal::check_lanczos_tol(tol)?;
+        Ok(())
+    }
+
     /// The integrator in use (the model's default for this scene unless one was set).
     pub fn integrator(&self) -> IntegratorSpec {
         self.integrator.unwrap_or_else(|| self.default_integrator())
@@ -294,6 +329,9 @@ impl Scene {
     /// [`DEFAULT_MICRO_STEP_TIMES_RATE`]), but at most 1/200 of the shortest period. Averaged: dopri5,
     /// whose steps grow to a good fraction of a period (the averaged model is not stiff).
     pub fn default_integrator(&self) -> IntegratorSpec {
+        if self.thermal.is_on() {
+            return self.default_noisy_integrator();
+        }
         match self.model {
             Model::Micro => IntegratorSpec::Rk4 {
                 dt: self.default_micro_step(),
@@ -304,6 +342,32 @@ impl Scene {
             Model::Rigid => IntegratorSpec::Dopri5 {
                 rtol: DEFAULT_RIGID_RTOL,
             },
+        }
+    }
+
+    /// The default with thermal noise: Euler-Maruyama. The spring model steps at
+    /// [`DEFAULT_NOISY_STEP_TIMES_RATE`]/rate (a spring's stationary variance comes out high by the
+    /// factor 1/(1 − rate·dt/2), 5%), at most 1/200 of the shortest period; the averaged model,
+    /// which has no stroke inside a period, at 1/20 of the period. The rigid-stroke model keeps its
+    /// default and refuses noise when it runs.
+    fn default_noisy_integrator(&self) -> IntegratorSpec {
+        let t_min = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(f64::INFINITY, f64::min);
+        let dt = match self.model {
+            Model::Micro => (DEFAULT_NOISY_STEP_TIMES_RATE / self.stiff_rate())
+                .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min),
+            Model::Averaged => t_min / 20.0,
+            Model::Rigid => {
+                return IntegratorSpec::Dopri5 {
+                    rtol: DEFAULT_RIGID_RTOL,
+                }
+            }
+        };
+        IntegratorSpec::Euler {
+            dt: if dt.is_finite() { dt } else { 1e-6 },
         }
     }
 

@@ -96,6 +96,19 @@ impl Spheres {
         }
     }
 
+    /// Velocities M·F for arbitrary sphere forces `f` (flat, 3 per sphere) at the current positions,
+    /// self drag included, into `out`: the mobility as an operator (the Lanczos square root).
+    pub(crate) fn apply_mobility(&mut self, f: &[f64], out: &mut [f64]) {
+        for (a, force) in self.forces.iter_mut().enumerate() {
+            *force = Vector3::new(f[3 * a], f[3 * a + 1], f[3 * a + 2]);
+        }
+        self.pair_velocities();
+        for (a, (u, r)) in self.u.iter().zip(&self.radii).enumerate() {
+            let v = u + self.forces[a] * self_mobility(self.mu, *r);
+            out[3 * a..3 * a + 3].copy_from_slice(v.as_slice());
+        }
+    }
+
     /// u_α = Σ_{β≠α} H_αβ F_β for the forces set.
     fn pair_velocities(&mut self) {
         let n = self.pos.len();

@@ -37,6 +37,9 @@ pub fn setting_in_script(s: &Setting) -> String {
         Setting::NoCutoff => "s.cutoff = ()".into(),
         Setting::AddSwimmer => "s.add(dumbbell(#{}))".into(),
         Setting::Lattice => "s.add_at(d, lattice::cubic(nx, ny, nz, spacing))".into(),
+        Setting::Mobility(m) => format!("s.mobility = \"{m}\""),
+        Setting::NoNoise => "s.temperature = 0".into(),
+        Setting::NoiseIntegrator => "s.integrator = euler(dt) or platen(dt)".into(),
     }
 }
 

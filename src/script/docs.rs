@@ -37,6 +37,7 @@ const GROUPS: &[&str] = &[
     "building",
     "phases",
     "numerics",
+    "thermal",
     "scene",
     "pictures",
     "running",

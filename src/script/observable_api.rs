@@ -121,6 +121,7 @@ pub fn register(engine: &mut Engine) {
     two!("D_H", DistanceH);
     two!("delta_q", DeltaQ);
     two!("delta_D_H", DeltaDistanceH);
+    two!("peclet", Peclet);
     engine
         .register_fn("pair_mean", |i: INT, j: INT| -> ScriptResult<Observable> {
             Ok(Observable::PairMean(index(i)?, index(j)?, Vector3::x()))
@@ -151,6 +152,7 @@ pub fn register(engine: &mut Engine) {
         .register_fn("min_gap", || Observable::MinGap)
         .register_fn("nematic", || Observable::Nematic)
         .register_fn("mean_speed", || Observable::MeanSpeed)
+        .register_fn("msd", || Observable::Msd)
         .register_fn(
             "pair_distances",
             |bins: INT, r_max: Dynamic| -> ScriptResult<Observable> {
@@ -285,6 +287,8 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("mean_speed", "observables", "mean_speed() -> Observable", "Mean swimming speed <|V|> over the swimmers (m/s). Averaged model: V = dR_H/dt. Sphere models: the displacement of R_H over the next period divided by T, measured on a copy of the scene (costs one period per evaluation).", "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [20e-6, 0, 0], phase: 1.0 })); s.model = \"averaged\"; print(s.observe(mean_speed()));"),
     doc_entry!("pair_distances", "observables", "pair_distances(bins, r_max) -> Observable", "Histogram of the hydrodynamic-centre distances D_H of all pairs: an array of bins counts, bin k covering [k, k+1) * r_max / bins (m); pairs at r_max or beyond are not counted. Recorded as columns D_H_hist[0], D_H_hist[1], ...", "let s = scene(); s.add_random(dumbbell(#{}), 30, 0.01, 2); print(s.observe(pair_distances(10, 100e-6)));"),
     doc_entry!("polarization", "observables", "polarization() -> Observable", "|<N>| over all swimmers.", "let s = scene(); s.add(dumbbell()); print(s.observe(polarization()));"),
+    doc_entry!("msd", "observables", "msd() -> Observable", "Mean squared displacement of the hydrodynamic centres since each swimmer was placed, averaged over the swimmers (m^2). With thermal noise it grows as 6 D_t t for free swimmers (s.diffusion(i).translation).", "let s = scene(); s.add(dumbbell()); s.temperature = 300; s.run_periods(0.2); print(s.observe(msd()));"),
+    doc_entry!("peclet", "observables", "peclet(i, j) -> Observable", "Peclet number of the pair (i, j): the deterministic drift of its mean position over one period, |V| T, against the rms diffusion of that mean along one axis in the same time, sqrt(2 D T), with D = (D_t^i + D_t^j)/4 (s.diffusion). The drift comes from a noise-free copy run one period with the model's default integrator (the averaged model: its rates now); needs a temperature above 0. Swimming beats diffusion after about 1/Pe^2 periods.", "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 })); s.model = \"averaged\"; s.temperature = 300; print(s.observe(peclet(0, 1)));"),
     doc_entry!("min_gap", "observables", "min_gap() -> Observable", "The smallest gap between the surfaces of any two spheres of the scene (m): how close the closest approach is. Through cell lists from 1,024 spheres (all pairs when the scene is too sparse for them to be sure), parallel for large scenes.", "let s = scene(); s.add(dumbbell(#{})); s.add(dumbbell(#{ center: [2e-5, 0.0, 0.0] })); print(s.observe(min_gap()));"),
     doc_entry!("nematic", "observables", "nematic() -> Observable", "Largest eigenvalue of Q = <3NN - I>/2.", "let s = scene(); s.add(dumbbell()); print(s.observe(nematic()));"),
     doc_entry!("record", "recording", "s.record([obs, ...], every) -> Recorder", "Record observables on a trigger: a number (every n periods), every_periods(n), every_seconds(t), at_times([..]) or at_end(). Periodic recorders take a row at once. Only the recorded observables are evaluated, only at their times.", docs::PAIR_RECORD),

@@ -92,18 +92,29 @@ impl std::fmt::Display for SceneHandle {
     }
 }
 
+/// The thermal part of a scene's summary: empty at 0 K.
+fn thermal_summary(s: &Scene) -> String {
+    let th = s.thermal();
+    if th.is_on() {
+        format!(" at {} K (seed {})", th.temperature, th.seed)
+    } else {
+        String::new()
+    }
+}
+
 /// One-line description of a scene (what `print(s)` shows).
 pub fn summary(s: &Scene) -> String {
     let backend = match s.backend() {
         Backend::Cpu => String::new(),
         b => format!(", backend = \"{}\"", b.name()),
     };
+    let thermal = thermal_summary(s);
     let period = s
         .period()
         .map(|t| format!(", T = {t:.6e} s"))
         .unwrap_or_default();
     format!(
-        "Scene({} swimmers, model = \"{}\", mobility = \"{}\", integrator = {}{}, mu = {:e} Pa s, t = {:.6e} s{period}{backend})",
+        "Scene({} swimmers, model = \"{}\", mobility = \"{}\", integrator = {}{}, mu = {:e} Pa s, t = {:.6e} s{period}{backend}{thermal})",
         s.count(),
         s.model().name(),
         s.mobility().name(),
@@ -393,8 +404,29 @@ pub fn register(engine: &mut Engine) {
             );
             m.insert("macro_steps".into(), (st.macro_steps as INT).into());
             m.insert("micro_periods".into(), (st.micro_periods as INT).into());
+            m.insert("noisy_steps".into(), (st.noisy_steps as INT).into());
             m
-        });
+        })
+        .register_fn(
+            "diffusion",
+            |s: &mut SceneHandle, i: INT| -> ScriptResult<rhai::Map> {
+                let i = usize::try_from(i).map_err(|_| {
+                    super::convert::script_error(format!("swimmer index {i} is negative"))
+                })?;
+                let d = s.with(|sc| sc.rigid_diffusion(i))?;
+                let mut m = rhai::Map::new();
+                for (k, v) in [
+                    ("parallel", d.parallel),
+                    ("perpendicular", d.perpendicular),
+                    ("translation", d.translation()),
+                    ("rotation", d.rotation),
+                    ("offset", d.offset),
+                ] {
+                    m.insert(k.into(), v.into());
+                }
+                Ok(m)
+            },
+        );
 }
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
@@ -409,7 +441,8 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("add_at", "scene", "s.add_at(d, centres: array) -> int", "Add a copy of dumbbell d (its orientation and phase) at every centre [x, y, z] (m) of the array, e.g. a lattice from the stdlib module \"lattice\". All or nothing: if one does not fit, the scene is unchanged. Returns the new swimmer count.", "import \"lattice\" as lattice; let s = scene(); s.add_at(dumbbell(), lattice::cubic(2, 2, 2, 20e-6)); print(s.count);"),
     doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
     doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
-    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations.", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
+    doc_entry!("diffusion", "thermal", "s.diffusion(i) -> map", "Swimmer i's diffusion as a rigid dumbbell of length ell at the scene's temperature and mobility: parallel and perpendicular translation D_par, D_perp (m^2/s), their orientation average translation = (D_par + 2 D_perp)/3 (a centre's mean squared displacement grows as 6 translation t), rotation D_r (1/s), and offset: where along N from R_H translation and rotation decouple (m). All zero at 0 K. The averaged model's noise; for a symmetric dumbbell translation equals kT/(12 pi mu)(1/a + 1/ell).", "let s = scene(); s.add(dumbbell()); s.temperature = 300; print(s.diffusion(0).translation);"),
+    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations; macro_steps and micro_periods of stroboscopic averaging; noisy_steps, the steps taken with thermal noise (also the noise generator's counter).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
     doc_entry!("center", "reading", "s.center(i) -> [x, y, z]", "Hydrodynamic centre R_H of swimmer i (m).", "let s = scene(); s.add(dumbbell()); print(s.center(0));"),
     doc_entry!("dir", "reading", "s.dir(i) -> [x, y, z]", "Unit orientation N of swimmer i (from the a1 sphere to the a2 sphere).", "let s = scene(); s.add(dumbbell(#{ dir: [0, 1, 0] })); print(s.dir(0));"),
     doc_entry!("velocity", "reading", "s.velocity(i) -> [x, y, z]", "dR_H/dt of swimmer i now (m/s).", docs::PAIR_VELOCITY),

@@ -7,6 +7,7 @@ use super::docs::{doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::choice::{self, Named};
 use crate::engine::integrators::METHODS;
+use crate::engine::thermal::NoiseRoot;
 use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric};
 use rhai::{Dynamic, Engine, ImmutableString, INT};
 
@@ -122,6 +123,53 @@ pub fn register(engine: &mut Engine) {
         Scene::set_overlaps,
         any,
     );
+    register_choice::<NoiseRoot>(
+        engine,
+        "noise_root",
+        |s| s.thermal().root,
+        Scene::set_noise_root,
+        any,
+    );
+    engine
+        .register_get("temperature", |s: &mut SceneHandle| {
+            s.borrow().thermal().temperature
+        })
+        .register_set(
+            "temperature",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let t = number("temperature", &v)?;
+                s.with_mut(|sc| sc.set_temperature(t))
+            },
+        )
+        .register_get("seed", |s: &mut SceneHandle| {
+            s.borrow().thermal().seed as INT
+        })
+        .register_set(
+            "seed",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let seed = v
+                    .as_int()
+                    .ok()
+                    .and_then(|i| u64::try_from(i).ok())
+                    .ok_or_else(|| {
+                        script_error(format!(
+                            "seed must be a whole number of 0 or more, got {v}; e.g. s.seed = 42"
+                        ))
+                    })?;
+                s.borrow_mut().scene_mut().set_seed(seed);
+                Ok(())
+            },
+        )
+        .register_get("lanczos_tol", |s: &mut SceneHandle| {
+            s.borrow().thermal().lanczos_tol
+        })
+        .register_set(
+            "lanczos_tol",
+            |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+                let tol = number("lanczos_tol", &v)?;
+                s.with_mut(|sc| sc.set_lanczos_tol(tol))
+            },
+        );
     engine
         .register_get("time", |s: &mut SceneHandle| s.borrow().time())
         .register_get("count", |s: &mut SceneHandle| s.borrow().count() as INT)
@@ -202,6 +250,10 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("coefficients", "numerics", "s.coefficients -> string\ns.coefficients = \"paper\" | \"leading_order\"", "Coefficients of the averaged model's I and J terms: as published, or the leading-order ones.", "let s = scene(); s.coefficients = \"leading_order\"; print(s.coefficients);"),
     doc_entry!("integrator_info", "numerics", "s.integrator_info -> string", "What the integrator runs on this scene: for auto(tol) the method it chose and why, else the integrator and whether it is the model's default.", "let s = scene(); s.add(dumbbell()); s.integrator = auto(1e-3); print(s.integrator_info);"),
     doc_entry!("integrator", "numerics", "s.integrator -> Integrator\ns.integrator = euler(dt) | rk4(dt) | dopri5(rtol) | rosw(rtol) | stroboscopic(tol) | auto(tol) | \"default\"", "The time integrator. The default depends on the model and the scene's stiffness.", "let s = scene(); s.add(dumbbell()); print(s.integrator); s.integrator = rk4(5e-6); print(s.integrator);"),
+    doc_entry!("temperature", "thermal", "s.temperature -> float\ns.temperature = kelvin", "Temperature (K) of the solvent; 0 (the default) turns thermal noise off and leaves every result as before. Above 0 the spring model's spheres take Brownian steps with covariance 2 kT M dt for the full mobility M (RPY is divergence-free, so no drift term), and the averaged model's swimmers diffuse as rigid dumbbells (s.diffusion(i)). Needs euler(dt) (Euler-Maruyama) or platen(dt) (weak order 2); the default becomes euler at 0.1/s.stiff_rate (spring model) or T/20 (averaged). Not in the rigid-stroke model; CPU only.", "let s = scene(); s.add(dumbbell()); s.temperature = 300; s.run_periods(0.1); print(s.integrator);"),
+    doc_entry!("seed", "thermal", "s.seed -> int\ns.seed = n", "Seed of the thermal noise (default 0). The noise of step k is a function of the seed and k alone (Philox4x32-10), so runs are reproducible, independent of the thread count, and a run split in two or saved and loaded between draws the same noise.", "let s = scene(); s.seed = 7; print(s.seed);"),
+    doc_entry!("noise_root", "thermal", "s.noise_root -> string\ns.noise_root = \"auto\" | \"cholesky\" | \"lanczos\"", "How the square root of the mobility is applied to the noise: the dense Cholesky factor (exact, O(N^3) a step), the Lanczos iteration on the pair kernel (O(N^2) a product, to s.lanczos_tol), or \"auto\": Cholesky up to 256 spheres, Lanczos above (the measured crossover).", "let s = scene(); s.noise_root = \"lanczos\"; print(s.noise_root);"),
+    doc_entry!("lanczos_tol", "thermal", "s.lanczos_tol -> float\ns.lanczos_tol = tol", "Tolerance of the Lanczos square root: it stops when sqrt(M) xi changes by less than tol of its size from one iteration to the next (default 1e-6).", "let s = scene(); s.lanczos_tol = 1e-8; print(s.lanczos_tol);"),
     doc_entry!("mu", "numerics", "s.mu -> float\ns.mu = x", "Viscosity (Pa s).", "let s = scene(); s.mu = 2e-3; print(s.mu);"),
     doc_entry!("stiff_rate", "numerics", "s.stiff_rate -> float", "The largest spring relaxation rate k0 (1/gamma1 + 1/gamma2) (1/s); explicit steps need dt below ~2.8/rate.", "let s = scene(); s.add(dumbbell()); print(s.stiff_rate);"),
     doc_entry!("time", "running", "s.time -> float", "Current time (s).", "let s = scene(); print(s.time);"),

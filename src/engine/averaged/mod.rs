@@ -20,11 +20,12 @@ mod lanes;
 
 use super::cells::CellGrid;
 use super::contacts::Contacts;
-use super::integrators::{OdeSystem, Problem};
-use super::mobility::self_mobility;
+use super::integrators::{Noise, OdeSystem, Problem};
+use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, Coefficients, STATE_PER_SWIMMER};
 use super::pairs::SoaSpheres;
 use super::swimmer::Dumbbell;
+use super::thermal::{RigidDiffusion, Thermal};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -180,6 +181,8 @@ pub struct AveragedSystem {
     cells: Option<bool>,
     /// Sum all-pairs rows in vector lanes: `None` decides by size ([`LANE_SWIMMERS`]).
     lanes: Option<bool>,
+    /// Thermal noise: the seed and each swimmer's rigid-dumbbell diffusion.
+    thermal: Option<(u64, Vec<RigidDiffusion>)>,
 }
 
 /// From this many swimmers the all-pairs rows are summed in vector lanes ([`lanes`]); below it
@@ -246,6 +249,7 @@ impl AveragedSystem {
             lanes: None,
             cell_soa: Soa::default(),
             cell_phase: Vec::new(),
+            thermal: None,
         };
         if shortcuts.aligned_1d {
             sys.axis = sys.common_axis(y);
@@ -270,6 +274,27 @@ impl AveragedSystem {
             // The 1D reduction has no sphere geometry.
             self.axis = None;
         }
+    }
+
+    /// Thermal noise at `thermal`'s temperature: every swimmer diffuses as a rigid dumbbell of
+    /// length ℓ ([`RigidDiffusion`]) in fluid of viscosity `mu` with the pair `mobility`.
+    pub fn set_thermal(
+        &mut self,
+        thermal: Thermal,
+        swimmers: &[Dumbbell],
+        mu: f64,
+        mobility: Mobility,
+    ) -> crate::engine::error::Result<()> {
+        self.thermal = if thermal.is_on() {
+            let d = swimmers
+                .iter()
+                .map(|d| RigidDiffusion::new(d, d.ell, mu, mobility, thermal.kt()))
+                .collect::<crate::engine::error::Result<Vec<_>>>()?;
+            Some((thermal.seed, d))
+        } else {
+            None
+        };
+        Ok(())
     }
 
     /// The steric rates (dR_H/dt, dN/dt) of swimmer σ from the forces on its spheres.
@@ -629,6 +654,44 @@ impl OdeSystem for AveragedSystem {
             Some((gap, a, b)) => Err(super::spheres::overlap_problem(gap, a, b)),
             None => Ok(()),
         }
+    }
+
+    fn noise(&self) -> Option<Noise> {
+        self.thermal.as_ref().map(|(seed, _)| Noise {
+            seed: *seed,
+            dim: STATE_PER_SWIMMER * self.coef.len(),
+        })
+    }
+
+    /// Each swimmer's centre of mobility C = R_H + z_c N takes a step √(2D_∥)(N·ξ)N +
+    /// √(2D_⊥)(1 − NNᵀ)ξ, its orientation turns to (N + √(2D_r)(1 − NNᵀ)ξ')/|…| (the
+    /// normalisation carries the Itô drift −2D_r N dt of rotational diffusion), and R_H = C − z_c N
+    /// follows: translation and rotation are independent about C, not about R_H.
+    fn add_noise(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        dw: &[f64],
+        y_new: &mut [f64],
+    ) -> Result<(), Problem> {
+        let Some((_, diffusion)) = &self.thermal else {
+            return Ok(());
+        };
+        for (s, d) in diffusion.iter().enumerate() {
+            let i = STATE_PER_SWIMMER * s;
+            let n = vec3(y, i + 3).normalize();
+            let (xi, xr) = (vec3(dw, i), vec3(dw, i + 3));
+            let along = n * n.dot(&xi);
+            let dc =
+                (2.0 * d.parallel).sqrt() * along + (2.0 * d.perpendicular).sqrt() * (xi - along);
+            let n_det = vec3(y_new, i + 3).normalize();
+            let turned = (vec3(y_new, i + 3) + (2.0 * d.rotation).sqrt() * (xr - n * n.dot(&xr)))
+                .normalize();
+            let r = vec3(y_new, i) + dc - d.offset * (turned - n_det);
+            set_vec3(y_new, i, &r);
+            set_vec3(y_new, i + 3, &turned);
+        }
+        Ok(())
     }
 
     /// Renormalise every N (the projector keeps dN/dt tangent; the step leaves it off by O(h²)).

@@ -1,13 +1,17 @@
-//! Explicit (forward) Euler, first order.
+//! Explicit (forward) Euler, first order; with thermal noise on, Euler-Maruyama (weak order 1).
 
+use super::sde::wiener_increments;
 use super::system::{check_state, fit, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
 
-/// Forward Euler with steps of at most `dt`.
+/// Forward Euler with steps of at most `dt`: y ← y + h f(t, y), plus B(t, y)·ΔW when the system
+/// has thermal noise (Euler-Maruyama; its stationary variance of a mode relaxing at rate κ is
+/// biased by the factor 1/(1 − κh/2)).
 #[derive(Debug, Clone)]
 pub struct Euler {
     dt: f64,
     k: Vec<f64>,
     y_new: Vec<f64>,
+    dw: Vec<f64>,
 }
 
 impl Euler {
@@ -17,6 +21,7 @@ impl Euler {
             dt,
             k: Vec::new(),
             y_new: Vec::new(),
+            dw: Vec::new(),
         }
     }
 }
@@ -38,11 +43,20 @@ impl Stepper for Euler {
         for i in 0..n {
             self.y_new[i] = y[i] + h * self.k[i];
         }
+        let noise = sys.noise();
+        if let Some(noise) = noise {
+            wiener_increments(noise, stats.noisy_steps, h, &mut self.dw);
+            sys.add_noise(t, y, &self.dw, &mut self.y_new)
+                .map_err(|problem| StepFailure { time: t, problem })?;
+        }
         sys.project(&mut self.y_new);
         let t_new = if last { t_end } else { t + h };
         check_state(sys, t_new, &self.y_new)?;
         y.copy_from_slice(&self.y_new);
         stats.steps += 1;
+        if noise.is_some() {
+            stats.noisy_steps += 1;
+        }
         Ok(t_new)
     }
 }

@@ -3,23 +3,29 @@
 //! Fixed-step methods ([`Euler`], [`Rk4`]) split a run into equal steps no longer than `dt` so that a
 //! run of any duration lands exactly on its end time. The adaptive [`Dopri5`] controls the error
 //! per component against [`OdeSystem::error_scale`], which the models set to the size of the slow
-//! drift rather than of the absolute positions (see `engine::micro`).
+//! drift rather than of the absolute positions (see `engine::micro`). With thermal noise on
+//! ([`OdeSystem::noise`]), [`Euler`] is Euler-Maruyama and [`Platen`] a weak second-order scheme;
+//! their noise comes from a counter-based generator ([`StepDraws`]).
 
 mod dopri5;
 mod euler;
+mod philox;
 mod rk4;
 mod rosenbrock;
+mod sde;
 mod spec;
 mod stroboscopic;
 mod system;
 
 pub use dopri5::Dopri5;
 pub use euler::Euler;
+pub use philox::StepDraws;
 pub use rk4::Rk4;
 pub use rosenbrock::Rosenbrock;
+pub use sde::Platen;
 pub use spec::{Direct, IntegratorSpec, Method, METHODS};
 pub use stroboscopic::{Stroboscopic, MIN_MACRO};
 pub use system::{
-    require_resolvable, uniform_steps, Interrupt, OdeSystem, Problem, Stats, StepFailure, Stepper,
-    MIN_RELATIVE_INTERVAL,
+    require_resolvable, uniform_steps, Interrupt, Noise, OdeSystem, Problem, Stats, StepFailure,
+    Stepper, MIN_RELATIVE_INTERVAL,
 };

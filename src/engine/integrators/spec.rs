@@ -1,6 +1,6 @@
 //! The user's choice of integrator, as saved with a scene.
 
-use super::{Dopri5, Euler, Rk4, Rosenbrock, Stepper};
+use super::{Dopri5, Euler, Platen, Rk4, Rosenbrock, Stepper};
 use crate::engine::error::invalid;
 use crate::engine::error::{require_positive, Result};
 use serde::{Deserialize, Serialize};
@@ -24,6 +24,12 @@ pub enum IntegratorSpec {
     Dopri5 {
         /// Relative tolerance (of the drift-sized error scale, see the models).
         rtol: f64,
+    },
+    /// Platen's explicit weak second-order scheme with maximum step `dt` (s) (see
+    /// [`super::Platen`]); without thermal noise, Heun's method.
+    Platen {
+        /// Maximum step (s).
+        dt: f64,
     },
     /// Adaptive Rosenbrock-W ROS34PW2 (stiff; implicit in each dumbbell's own dynamics).
     Rosw {
@@ -92,6 +98,9 @@ impl TryFrom<IntegratorSpec> for Direct {
             IntegratorSpec::Rk4 { dt } => Ok(Direct::Rk4 { dt }),
             IntegratorSpec::Dopri5 { rtol } => Ok(Direct::Dopri5 { rtol }),
             IntegratorSpec::Rosw { rtol } => Ok(Direct::Rosw { rtol }),
+            IntegratorSpec::Platen { .. } => Err(invalid!(
+                "platen(dt) is a scheme for thermal noise, and stroboscopic averaging is deterministic; give a direct inner integrator such as rk4(dt) or dopri5(rtol)"
+            )),
             IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => Err(invalid!(
                 "stroboscopic averaging cannot sample itself; give a direct inner integrator such as rk4(dt) or dopri5(rtol)"
             )),
@@ -155,6 +164,14 @@ const AUTO: Method = Method {
     make: IntegratorSpec::auto,
 };
 
+const PLATEN: Method = Method {
+    name: "platen",
+    parameter: "dt",
+    parameter_about: "the step in s",
+    about: "Platen's weak order 2 scheme for thermal noise, fixed step (Heun without noise)",
+    make: IntegratorSpec::platen,
+};
+
 const ROSW: Method = Method {
     name: "rosw",
     parameter: "rtol",
@@ -164,7 +181,7 @@ const ROSW: Method = Method {
 };
 
 /// Every method, in the order messages list them.
-pub const METHODS: &[Method] = &[EULER, RK4, DOPRI5, STROBOSCOPIC, AUTO, ROSW];
+pub const METHODS: &[Method] = &[EULER, RK4, DOPRI5, STROBOSCOPIC, AUTO, ROSW, PLATEN];
 
 impl IntegratorSpec {
     /// The method's entry in [`METHODS`].
@@ -174,6 +191,7 @@ impl IntegratorSpec {
             IntegratorSpec::Rk4 { .. } => &RK4,
             IntegratorSpec::Dopri5 { .. } => &DOPRI5,
             IntegratorSpec::Rosw { .. } => &ROSW,
+            IntegratorSpec::Platen { .. } => &PLATEN,
             IntegratorSpec::Stroboscopic { .. } => &STROBOSCOPIC,
             IntegratorSpec::Auto { .. } => &AUTO,
         }
@@ -182,7 +200,9 @@ impl IntegratorSpec {
     /// The one parameter's value: the step (s) or the tolerance.
     pub fn parameter(&self) -> f64 {
         match *self {
-            IntegratorSpec::Euler { dt } | IntegratorSpec::Rk4 { dt } => dt,
+            IntegratorSpec::Euler { dt }
+            | IntegratorSpec::Rk4 { dt }
+            | IntegratorSpec::Platen { dt } => dt,
             IntegratorSpec::Dopri5 { rtol } | IntegratorSpec::Rosw { rtol } => rtol,
             IntegratorSpec::Stroboscopic { tol, .. } | IntegratorSpec::Auto { tol } => tol,
         }
@@ -198,6 +218,20 @@ impl IntegratorSpec {
     pub fn rk4(dt: f64) -> Result<Self> {
         require_positive("rk4(dt): dt", dt, "s")?;
         Ok(IntegratorSpec::Rk4 { dt })
+    }
+
+    /// Platen's weak second-order scheme, checked.
+    pub fn platen(dt: f64) -> Result<Self> {
+        require_positive("platen(dt): dt", dt, "s")?;
+        Ok(IntegratorSpec::Platen { dt })
+    }
+
+    /// Whether the method is a scheme for thermal noise (Euler-Maruyama or Platen's).
+    pub fn takes_noise(&self) -> bool {
+        matches!(
+            self,
+            IntegratorSpec::Euler { .. } | IntegratorSpec::Platen { .. }
+        )
     }
 
     /// Dormand-Prince 5(4), checked: 1e-14 ≤ rtol < 1.
@@ -235,6 +269,7 @@ impl IntegratorSpec {
             IntegratorSpec::Rk4 { dt } => Box::new(Rk4::new(dt)),
             IntegratorSpec::Dopri5 { rtol } => Box::new(Dopri5::new(rtol)),
             IntegratorSpec::Rosw { rtol } => Box::new(Rosenbrock::new(rtol)),
+            IntegratorSpec::Platen { dt } => Box::new(Platen::new(dt)),
             IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => return None,
         })
     }

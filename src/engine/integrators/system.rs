@@ -1,6 +1,7 @@
 //! The contract between models and integrators.
 
 use crate::engine::error::{invalid, Setting};
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// A first-order system dy/dt = f(t, y) with the hooks the integrators need.
@@ -26,6 +27,43 @@ pub trait OdeSystem {
     /// The diagonal blocks of (an approximation to) ∂f/∂y at (t, y), row-major, one after another.
     /// The models put the stiff part there: each dumbbell's own spring, drag and hydrodynamics.
     fn jacobian_blocks(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) {}
+    /// Thermal noise: the Itô system dy = f dt + B(t, y) dW. `None` (the default): deterministic.
+    fn noise(&self) -> Option<Noise> {
+        None
+    }
+    /// Add one step's stochastic increment to `y_new`, which holds the deterministic update:
+    /// B(t, y)·dw for the Wiener increments `dw` (one per noise dimension, variance h each). A
+    /// model whose state has a constraint (a unit orientation) applies it on the constraint.
+    fn add_noise(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        _dw: &[f64],
+        _y_new: &mut [f64],
+    ) -> Result<(), Problem> {
+        Ok(())
+    }
+    /// The diffusion matrix B(t, y) (dim × noise dimension), for weak schemes that need its
+    /// columns at several points.
+    fn diffusion(&mut self, _t: f64, _y: &[f64], _b: &mut DMatrix<f64>) -> Result<(), Problem> {
+        Err(Problem {
+            swimmer: None,
+            cause: "this model gives no diffusion matrix".into(),
+            hint: "use euler(dt), Euler-Maruyama".into(),
+            fixes: Vec::new(),
+        })
+    }
+}
+
+/// The thermal noise of a system: its generator's seed and the number of independent Wiener
+/// processes driving it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Noise {
+    /// Seed of the counter-based generator ([`super::philox`]); its counter is the step count
+    /// [`Stats::noisy_steps`].
+    pub seed: u64,
+    /// Number of independent Wiener processes.
+    pub dim: usize,
 }
 
 /// What made a state unacceptable.
@@ -68,6 +106,10 @@ pub struct Stats {
     /// Microscopic periods stroboscopic averaging integrated (samples, transients, remainders).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub micro_periods: u64,
+    /// Steps taken with thermal noise; also the noise generator's counter, so that a run split in
+    /// two, or saved and loaded between, draws the same noise (saved only when non-zero).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub noisy_steps: u64,
 }
 
 fn is_zero(n: &u64) -> bool {

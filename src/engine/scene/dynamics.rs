@@ -51,6 +51,21 @@ impl Scene {
         Ok((v, spin))
     }
 
+    /// Swimmer `i`'s diffusion as a rigid dumbbell of length ℓ at the scene's temperature, with
+    /// the scene's mobility (all zero at 0 K): the averaged model's noise, and the long-time
+    /// diffusion of a spring dumbbell's centre whose length fluctuates little about ℓ.
+    pub fn rigid_diffusion(&self, i: usize) -> Result<crate::engine::thermal::RigidDiffusion> {
+        self.check_index(i)?;
+        let d = &self.swimmers[i];
+        crate::engine::thermal::RigidDiffusion::new(
+            d,
+            d.ell,
+            self.mu,
+            self.mobility,
+            self.thermal.kt(),
+        )
+    }
+
     /// The state vector (see [`super::model`]) and the base positions: for tests and savers.
     pub fn raw_state(&self) -> (&[f64], &[Vector3<f64>]) {
         (&self.state, &self.base)
@@ -58,13 +73,17 @@ impl Scene {
 
     pub(crate) fn system(&self) -> Result<Box<dyn OdeSystem>> {
         Ok(match self.model {
-            Model::Micro => Box::new(MicroSystem::new(
-                &self.swimmers,
-                &self.base,
-                self.mu,
-                self.mobility,
-                self.contacts,
-            )),
+            Model::Micro => {
+                let mut sys = MicroSystem::new(
+                    &self.swimmers,
+                    &self.base,
+                    self.mu,
+                    self.mobility,
+                    self.contacts,
+                );
+                sys.set_thermal(self.thermal);
+                Box::new(sys)
+            }
             Model::Rigid => {
                 if self.contacts.steric.is_some() {
                     return Err(unsupported(
@@ -86,6 +105,7 @@ impl Scene {
                     AveragedSystem::new(&self.swimmers, &self.base, self.coefficients, &self.state);
                 sys.set_cutoff(self.cutoff);
                 sys.set_contacts(self.contacts, self.mu);
+                sys.set_thermal(self.thermal, &self.swimmers, self.mu, self.mobility)?;
                 Box::new(sys)
             }
         })
@@ -116,6 +136,12 @@ pub const RK4_DEFAULT_DRIFT_ERROR: f64 = 1.1e-6;
 /// averaging then sample with rosw, whose steps the springs do not limit.
 pub const STIFF_STEPS_PER_PERIOD: f64 = 2e4;
 
+/// The most swimmers Platen's scheme takes: it factors the 6S×6S mobility 4·6S + 1 times a step.
+pub const PLATEN_MAX_SWIMMERS: usize = 16;
+
+/// The most spheres a dense Cholesky factor of the mobility is made for (a 12,288² matrix, 1.2 GB).
+pub const CHOLESKY_LIMIT_SPHERES: usize = 4096;
+
 /// e^-37 ≈ 1e-16: a spring mode relaxed this many e-foldings is gone to round-off.
 const RELAXED_E_FOLDINGS: f64 = 37.0;
 
@@ -139,6 +165,7 @@ impl Scene {
     /// A fresh stepper for `spec` on this scene. Stroboscopic averaging needs the common period,
     /// the slowest spring relaxation (how many periods relax the fast motion) and a length scale.
     pub(crate) fn stepper(&self, spec: IntegratorSpec) -> Result<Box<dyn Stepper>> {
+        self.check_noise(spec)?;
         if let Some(st) = spec.build() {
             return Ok(st);
         }
@@ -184,6 +211,54 @@ impl Scene {
             relax,
             length,
         )))
+    }
+
+    /// What thermal noise refuses: the rigid-stroke model, deterministic integrators, and Platen's
+    /// scheme where it has no diffusion matrix or would cost too much.
+    fn check_noise(&self, spec: IntegratorSpec) -> Result<()> {
+        let th = self.thermal;
+        if !th.is_on() {
+            return Ok(());
+        }
+        let t = th.temperature;
+        if self.model == Model::Rigid {
+            return Err(unsupported(
+                format!("thermal noise (temperature {t} K) is not available in the rigid-stroke model: Brownian motion under a rigid constraint needs the metric (Fixman) drift, which changes the equilibrium this model would sample"),
+                &[Setting::Model("micro"), Setting::Model("averaged"), Setting::NoNoise],
+            ));
+        }
+        if !spec.takes_noise() {
+            return Err(unsupported(
+                format!("{spec} is a deterministic method and cannot carry thermal noise (temperature {t} K): a Brownian path is nowhere smooth, which adaptive error control and stroboscopic averaging assume, so the noise needs a stochastic scheme"),
+                &[Setting::NoiseIntegrator, Setting::DefaultIntegrator, Setting::NoNoise],
+            ));
+        }
+        if let IntegratorSpec::Platen { .. } = spec {
+            if self.model == Model::Averaged {
+                return Err(unsupported(
+                    format!("{spec} needs the diffusion matrix at shifted states, and the averaged model turns its orientations on the unit sphere instead"),
+                    &[Setting::NoiseIntegrator, Setting::DefaultIntegrator],
+                ));
+            }
+            if self.count() > PLATEN_MAX_SWIMMERS {
+                return Err(invalid!(
+                    "{spec} factors the mobility at 4m + 1 states a step (m = 6 per swimmer), a cost growing as the swimmer count to the 4th power; it takes at most {PLATEN_MAX_SWIMMERS} swimmers, this scene has {}: use euler(dt) with a smaller step",
+                    self.count()
+                ));
+            }
+        }
+        let spheres = 2 * self.count();
+        if self.model == Model::Micro
+            && th.root.dense_for(spheres)
+            && spheres > CHOLESKY_LIMIT_SPHERES
+        {
+            return Err(invalid!(
+                "the dense Cholesky factor of {spheres} spheres needs a {0}x{0} matrix ({1:.1} GB) and O(N^3) work every step; use the Lanczos square root (noise root \"lanczos\" or \"auto\")",
+                3 * spheres,
+                (3 * spheres) as f64 * (3 * spheres) as f64 * 8e-9
+            ));
+        }
+        Ok(())
     }
 
     /// What `auto(tol)` runs on this scene, and why. The averaged model: dopri5 a hundred times

@@ -68,6 +68,7 @@ impl Scene {
         match self.integrator {
             Some(IntegratorSpec::Euler { dt }) => IntegratorSpec::euler(dt).map(|_| ())?,
             Some(IntegratorSpec::Rk4 { dt }) => IntegratorSpec::rk4(dt).map(|_| ())?,
+            Some(IntegratorSpec::Platen { dt }) => IntegratorSpec::platen(dt).map(|_| ())?,
             Some(IntegratorSpec::Dopri5 { rtol }) => IntegratorSpec::dopri5(rtol).map(|_| ())?,
             Some(IntegratorSpec::Rosw { rtol }) => IntegratorSpec::rosw(rtol).map(|_| ())?,
             Some(IntegratorSpec::Stroboscopic { tol, inner }) => {
@@ -83,6 +84,7 @@ impl Scene {
         if let Some(st) = self.contacts.steric {
             Steric::new(st.range, st.stiffness)?;
         }
+        self.thermal.validate()?;
         if let Some(c) = self.cutoff {
             let mut probe = Scene::new();
             probe.set_cutoff(Some(c))?;
