@@ -32,6 +32,7 @@ fn main() {
         .unwrap_or(1024);
     println!("spheres  cholesky [ms]  lanczos [ms]  cholesky/lanczos");
     let mut spheres = 8;
+    let mut crossover = None;
     while spheres <= max {
         let c = step_time(spheres / 2, NoiseRoot::Cholesky);
         let l = step_time(spheres / 2, NoiseRoot::Lanczos);
@@ -41,6 +42,19 @@ fn main() {
             l * 1e3,
             c / l
         );
-        spheres *= 2;
+        match crossover {
+            None if l < c => crossover = Some(spheres),
+            Some(_) if l >= c => crossover = None,
+            _ => {}
+        }
+        // Steps of about 1.25x, even (two spheres a dumbbell).
+        spheres = (spheres * 5 / 4 + 1) & !1;
+    }
+    match crossover {
+        Some(n) => println!(
+            "Lanczos is faster from {n} spheres on; \"auto\" takes Cholesky up to {} spheres",
+            swimlab::engine::thermal::CHOLESKY_MAX_SPHERES
+        ),
+        None => println!("Cholesky was faster up to {max} spheres"),
     }
 }
