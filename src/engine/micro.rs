@@ -58,14 +58,17 @@ impl MicroSystem {
         m.cholesky().map(|c| c.unpack()).ok_or_else(not_positive)
     }
 
-    /// Sphere displacements (flat, 3 per sphere) into state increments added to `out`:
-    /// ΔR_H = w1 Δx₁ + w2 Δx₂, Δb = Δx₂ − Δx₁, each scaled by `scale`.
-    fn add_to_state(&self, dx: impl Fn(usize) -> f64, scale: f64, out: &mut [f64]) {
+    /// Sphere displacements `dx` (flat, 3 per sphere) as state increments, scaled by `scale`, given
+    /// to `add(state index, increment)`: ΔR_H = w1 Δx₁ + w2 Δx₂, Δb = Δx₂ − Δx₁.
+    fn to_state(&self, dx: impl Fn(usize) -> f64, scale: f64, mut add: impl FnMut(usize, f64)) {
         for (s, d) in self.swimmers.iter().enumerate() {
             for k in 0..3 {
                 let (x1, x2) = (dx(6 * s + k), dx(6 * s + 3 + k));
-                out[STATE_PER_SWIMMER * s + k] += scale * (d.w1() * x1 + d.w2() * x2);
-                out[STATE_PER_SWIMMER * s + 3 + k] += scale * (x2 - x1);
+                add(
+                    STATE_PER_SWIMMER * s + k,
+                    scale * (d.w1() * x1 + d.w2() * x2),
+                );
+                add(STATE_PER_SWIMMER * s + 3 + k, scale * (x2 - x1));
             }
         }
     }
@@ -192,7 +195,7 @@ impl OdeSystem for MicroSystem {
         if th.root.dense_for(self.spheres.pos.len()) {
             let l = self.mobility_factor()?;
             let dx = l * nalgebra::DVector::from_column_slice(dw);
-            self.add_to_state(|i| dx[i], scale, y_new);
+            self.to_state(|i| dx[i], scale, |i, v| y_new[i] += v);
             return Ok(());
         }
         let mut kicks = std::mem::take(&mut self.kicks);
@@ -202,7 +205,7 @@ impl OdeSystem for MicroSystem {
         let outcome = lanczos::sqrt_times(&mut apply, dw, th.lanczos_tol, &mut kicks);
         let result = match outcome {
             Ok(_) => {
-                self.add_to_state(|i| kicks[i], scale, y_new);
+                self.to_state(|i| kicks[i], scale, |i, v| y_new[i] += v);
                 Ok(())
             }
             Err(lanczos::LanczosFailure::NotPositive(_)) => Err(not_positive()),
@@ -226,12 +229,8 @@ impl OdeSystem for MicroSystem {
         self.place(y);
         let l = self.mobility_factor()?;
         let scale = (2.0 * th.kt()).sqrt();
-        b.fill(0.0);
         for col in 0..l.ncols() {
-            let mut column = b.column_mut(col);
-            let mut tmp = vec![0.0; column.len()];
-            self.add_to_state(|i| l[(i, col)], scale, &mut tmp);
-            column.copy_from_slice(&tmp);
+            self.to_state(|i| l[(i, col)], scale, |i, v| b[(i, col)] = v);
         }
         Ok(())
     }

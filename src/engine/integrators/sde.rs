@@ -35,6 +35,7 @@ pub struct Platen {
     f0: Vec<f64>,
     f1: Vec<f64>,
     point: Vec<f64>,
+    drift: Vec<f64>,
     y_new: Vec<f64>,
     dw: Vec<f64>,
     b0: DMatrix<f64>,
@@ -50,6 +51,7 @@ impl Platen {
             f0: Vec::new(),
             f1: Vec::new(),
             point: Vec::new(),
+            drift: Vec::new(),
             y_new: Vec::new(),
             dw: Vec::new(),
             b0: DMatrix::zeros(0, 0),
@@ -58,20 +60,20 @@ impl Platen {
         }
     }
 
-    /// B at y + c·(column `col` of b0) + `shift` into `bp` (c > 0) and `bm` (−c).
-    #[allow(clippy::too_many_arguments)]
+    /// B at y (+ the step's drift fh when `drifted`) ± c·(column `col` of b0), into `bp` and `bm`.
     fn pair_at(
         &mut self,
         sys: &mut dyn OdeSystem,
         t: f64,
         y: &[f64],
-        shift: Option<&[f64]>,
+        drifted: bool,
         col: usize,
         c: f64,
     ) -> Result<(), StepFailure> {
         for (sign, plus) in [(1.0, true), (-1.0, false)] {
             for i in 0..y.len() {
-                self.point[i] = y[i] + shift.map_or(0.0, |s| s[i]) + sign * c * self.b0[(i, col)];
+                let shift = if drifted { self.drift[i] } else { 0.0 };
+                self.point[i] = y[i] + shift + sign * c * self.b0[(i, col)];
             }
             let target = if plus { &mut self.bp } else { &mut self.bm };
             sys.diffusion(t, &self.point, target)
@@ -93,7 +95,13 @@ impl Stepper for Platen {
         let n = y.len();
         fit(
             n,
-            &mut [&mut self.f0, &mut self.f1, &mut self.point, &mut self.y_new],
+            &mut [
+                &mut self.f0,
+                &mut self.f1,
+                &mut self.point,
+                &mut self.drift,
+                &mut self.y_new,
+            ],
         );
         let (h, last) = uniform_step(t, t_end, self.dt);
         let t_new = if last { t_end } else { t + h };
@@ -127,10 +135,12 @@ impl Stepper for Platen {
             let m = noise.dim;
             let sq = h.sqrt();
             let draws = StepDraws::new(noise.seed, stats.noisy_steps);
-            let drift: Vec<f64> = self.f0.iter().map(|f| h * f).collect();
+            for (d, f) in self.drift.iter_mut().zip(&self.f0) {
+                *d = h * f;
+            }
             // The R± terms: column j of B at y + fh ± bʲ√h.
             for j in 0..m {
-                self.pair_at(sys, t, y, Some(&drift), j, sq)?;
+                self.pair_at(sys, t, y, true, j, sq)?;
                 let dwj = self.dw[j];
                 for i in 0..n {
                     let (p, q, b) = (self.bp[(i, j)], self.bm[(i, j)], self.b0[(i, j)]);
@@ -140,7 +150,7 @@ impl Stepper for Platen {
             }
             // The U± terms: every column j ≠ r of B at y ± bʳ√h.
             for r in 0..m {
-                self.pair_at(sys, t, y, None, r, sq)?;
+                self.pair_at(sys, t, y, false, r, sq)?;
                 for j in (0..m).filter(|&j| j != r) {
                     let v = if r < j {
                         h * draws.sign((r * m + j) as u64)
