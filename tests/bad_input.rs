@@ -374,3 +374,50 @@ fn set_values_are_read_or_refused() {
     let out = swimlab(&["run", f, "--set", "tag=7"], "", &d);
     check("read in a string", &out, "tag=7", 0);
 }
+
+/// Thermal noise's bad input: each refused at the script position with the reason and the fix.
+#[test]
+fn thermal_noise_refuses_bad_settings_with_the_fix() {
+    case(
+        &format!("{PAIR}s.temperature = -5;"),
+        "temperature must lie between 0 and",
+        1,
+    );
+    case(&format!("{PAIR}s.temperature = \"hot\";"), "temperature", 1);
+    case(
+        &format!("{PAIR}s.seed = -1;"),
+        "seed must be a whole number of 0 or more",
+        1,
+    );
+    case(
+        &format!("{PAIR}s.seed = 1.5;"),
+        "seed must be a whole number",
+        1,
+    );
+    case(
+        &format!("{PAIR}s.noise_root = \"lanczo\";"),
+        "did you mean \"lanczos\"",
+        1,
+    );
+    case(
+        &format!("{PAIR}s.lanczos_tol = 0;"),
+        "lanczos_tol must lie in",
+        1,
+    );
+    case(
+        &format!("{PAIR}s.temperature = 300;\ns.integrator = rk4(1e-6);\ns.run_periods(1);"),
+        "use s.integrator = euler(dt) or platen(dt)",
+        1,
+    );
+    case(
+        &format!("{PAIR}s.model = \"rigid\";\ns.temperature = 300;\ns.run_periods(1);"),
+        "s.model = \"micro\"",
+        1,
+    );
+    case(
+        &format!("{PAIR}print(s.observe(peclet(0, 1)));"),
+        "set a temperature above 0 K",
+        1,
+    );
+    case(&format!("{PAIR}platen(-1.0);"), "platen(dt): dt", 1);
+}

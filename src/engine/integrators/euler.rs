@@ -1,7 +1,7 @@
 //! Explicit (forward) Euler, first order; with thermal noise on, Euler-Maruyama (weak order 1).
 
-use super::sde::wiener_increments;
-use super::system::{check_state, fit, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
+use super::sde::{accept, wiener_increments};
+use super::system::{fit, uniform_step, OdeSystem, Stats, StepFailure, Stepper};
 
 /// Forward Euler with steps of at most `dt`: y ← y + h f(t, y), plus B(t, y)·ΔW when the system
 /// has thermal noise (Euler-Maruyama; its stationary variance of a mode relaxing at rate κ is
@@ -49,14 +49,7 @@ impl Stepper for Euler {
             sys.add_noise(t, y, &self.dw, &mut self.y_new)
                 .map_err(|problem| StepFailure { time: t, problem })?;
         }
-        sys.project(&mut self.y_new);
         let t_new = if last { t_end } else { t + h };
-        check_state(sys, t_new, &self.y_new)?;
-        y.copy_from_slice(&self.y_new);
-        stats.steps += 1;
-        if noise.is_some() {
-            stats.noisy_steps += 1;
-        }
-        Ok(t_new)
+        accept(sys, t_new, &mut self.y_new, y, stats, noise.is_some())
     }
 }

@@ -166,13 +166,26 @@ impl Stepper for Platen {
                 }
             }
         }
-        sys.project(&mut self.y_new);
-        check_state(sys, t_new, &self.y_new)?;
-        y.copy_from_slice(&self.y_new);
-        stats.steps += 1;
-        if noise.is_some() {
-            stats.noisy_steps += 1;
-        }
-        Ok(t_new)
+        accept(sys, t_new, &mut self.y_new, y, stats, noise.is_some())
     }
+}
+
+/// Finish a fixed step: project and check the new state, take it, count the step (and the noise
+/// draw, whose counter it advances). On `Err` the state `y` is unchanged.
+pub(crate) fn accept(
+    sys: &mut dyn OdeSystem,
+    t_new: f64,
+    y_new: &mut [f64],
+    y: &mut [f64],
+    stats: &mut Stats,
+    noisy: bool,
+) -> Result<f64, StepFailure> {
+    sys.project(y_new);
+    check_state(sys, t_new, y_new)?;
+    y.copy_from_slice(y_new);
+    stats.steps += 1;
+    if noisy {
+        stats.noisy_steps += 1;
+    }
+    Ok(t_new)
 }
