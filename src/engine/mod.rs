@@ -31,6 +31,7 @@ mod spheres;
 pub mod stepping;
 pub mod swimmer;
 pub mod thermal;
+pub mod trajectory;
 
 pub use backend::Backend;
 pub use contacts::{Contacts, Overlaps, Steric};

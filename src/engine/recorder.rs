@@ -8,6 +8,7 @@ use super::integrators::require_resolvable;
 use super::observable::Observable;
 use super::scene::Scene;
 use super::stepping::{RunControl, Workspace};
+use super::trajectory::Trajectory;
 use serde::{Deserialize, Serialize};
 
 /// When a recorder takes a row.
@@ -83,6 +84,8 @@ pub struct Recorder {
     pub rows: Vec<Vec<f64>>,
     /// Where each new row is also appended as CSV, if anywhere.
     stream: Option<LineStream>,
+    /// The trajectory that takes a frame with every row, if this recorder writes one.
+    frames: Option<Trajectory>,
 }
 
 impl Recorder {
@@ -102,6 +105,27 @@ impl Recorder {
         scene: &Scene,
         observables: Vec<Observable>,
         trigger: Trigger,
+        probe: &mut Probe,
+    ) -> Result<Self> {
+        Self::start_with(scene, observables, trigger, None, probe)
+    }
+
+    /// A recorder that writes a frame of `trajectory` with every row (its rows hold the times of
+    /// the frames): the trajectory shares the recorders' triggers.
+    pub fn start_trajectory(
+        scene: &Scene,
+        trajectory: Trajectory,
+        trigger: Trigger,
+        probe: &mut Probe,
+    ) -> Result<Self> {
+        Self::start_with(scene, Vec::new(), trigger, Some(trajectory), probe)
+    }
+
+    fn start_with(
+        scene: &Scene,
+        observables: Vec<Observable>,
+        trigger: Trigger,
+        frames: Option<Trajectory>,
         probe: &mut Probe,
     ) -> Result<Self> {
         trigger.validate()?;
@@ -132,6 +156,7 @@ impl Recorder {
             next_k: 0,
             rows: Vec::new(),
             stream: None,
+            frames,
         };
         if r.interval.is_some() {
             r.take(scene, probe)?;
@@ -245,7 +270,16 @@ impl Recorder {
             None => Ok(()),
         };
         self.rows.push(row);
-        streamed
+        streamed?;
+        match &mut self.frames {
+            Some(t) => t.write_frame(scene),
+            None => Ok(()),
+        }
+    }
+
+    /// The trajectory this recorder writes, if any.
+    pub fn trajectory(&self) -> Option<&Trajectory> {
+        self.frames.as_ref()
     }
 
     /// Stream rows to `path` as CSV from now on: the file is created with the header and every

@@ -185,6 +185,17 @@ impl Simulation {
         Ok(self.add_recorder(r))
     }
 
+    /// Write the scene's spheres to the trajectory file `path` (`.xyz` or `.pvd`, see
+    /// [`super::trajectory`]) on `trigger`, frame by frame as runs go; returns the id of the
+    /// recorder that writes it (its rows are the frames' times).
+    pub fn trajectory(&mut self, path: &std::path::Path, trigger: Trigger) -> Result<usize> {
+        trigger.validate()?;
+        let t = super::trajectory::Trajectory::create(path)?;
+        let mut probe = Probe::new(&mut self.probes, &self.control);
+        let r = Recorder::start_trajectory(&self.scene, t, trigger, &mut probe)?;
+        Ok(self.add_recorder(r))
+    }
+
     /// Attach a recorder made elsewhere; returns its id.
     pub fn add_recorder(&mut self, r: Recorder) -> usize {
         self.recorders.push(r);

@@ -6,7 +6,7 @@ use super::docs::{self, doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::{Observable, Recorder, Trigger};
 use nalgebra::Vector3;
-use rhai::{Array, Dynamic, Engine, Map, INT};
+use rhai::{Array, Dynamic, Engine, ImmutableString, Map, INT};
 
 /// A script's handle on one recorder of a scene.
 #[derive(Debug, Clone)]
@@ -205,6 +205,23 @@ pub fn register(engine: &mut Engine) {
                 })
             },
         )
+        .register_fn(
+            "trajectory",
+            |s: &mut SceneHandle,
+             path: ImmutableString,
+             every: Dynamic|
+             -> ScriptResult<RecorderHandle> {
+                let trigger = trigger_of(&every)?;
+                let id = lift(
+                    s.borrow_mut()
+                        .trajectory(std::path::Path::new(path.as_str()), trigger),
+                )?;
+                Ok(RecorderHandle {
+                    scene: s.clone(),
+                    id,
+                })
+            },
+        )
         .register_get("len", |r: &mut RecorderHandle| -> ScriptResult<INT> {
             r.with(|rec| rec.rows.len() as INT)
         })
@@ -292,6 +309,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("min_gap", "observables", "min_gap() -> Observable", "The smallest gap between the surfaces of any two spheres of the scene (m): how close the closest approach is. Through cell lists from 1,024 spheres (all pairs when the scene is too sparse for them to be sure), parallel for large scenes.", "let s = scene(); s.add(dumbbell(#{})); s.add(dumbbell(#{ center: [2e-5, 0.0, 0.0] })); print(s.observe(min_gap()));"),
     doc_entry!("nematic", "observables", "nematic() -> Observable", "Largest eigenvalue of Q = <3NN - I>/2.", "let s = scene(); s.add(dumbbell()); print(s.observe(nematic()));"),
     doc_entry!("record", "recording", "s.record([obs, ...], every) -> Recorder", "Record observables on a trigger: a number (every n periods), every_periods(n), every_seconds(t), at_times([..]) or at_end(). Periodic recorders take a row at once. Only the recorded observables are evaluated, only at their times.", docs::PAIR_RECORD),
+    doc_entry!("trajectory", "recording", "s.trajectory(path, every) -> Recorder", "Write the spheres frame by frame as the runs go, on a trigger as s.record takes (a number of periods, every_periods, every_seconds, at_times, at_end), for particle viewers: path.xyz is extended XYZ (ASE, OVITO: one particle per sphere, positions and radius in um, swimmer index, sphere 1 or 2, orientation N, the time in s on each comment line), each frame appended with one write when it is due, so a kill or Ctrl-C loses no frame already written; path.pvd is a ParaView series, one .vtp file per frame in the folder <name>_frames beside it (point arrays radius, swimmer, sphere, N for glyphs) and the .pvd listing them with their times. The recorder's rows are the frames' times.", "let s = scene(); s.add(dumbbell()); let t = s.trajectory(\"out/help/pair.xyz\", 0.5); s.run_periods(1); print(t.len);"),
     doc_entry!("every_periods", "recording", "every_periods(n) -> Trigger", "Every n periods from now.", "print(every_periods(2));"),
     doc_entry!("every_seconds", "recording", "every_seconds(t) -> Trigger", "Every t seconds from now.", "print(every_seconds(1e-3));"),
     doc_entry!("at_times", "recording", "at_times([t1, t2, ...]) -> Trigger", "At the given absolute times (s).", "print(at_times([0.01, 0.02]));"),

@@ -1,0 +1,249 @@
+//! Trajectories for particle viewers: the spheres of a scene written frame by frame as a run goes,
+//! one particle per sphere, on a recorder's trigger.
+//!
+//! - Extended XYZ (`.xyz`; ASE, OVITO): one frame after another in one file. Positions and radii
+//!   in µm (the comment line says so: `length_unit=um`), with the swimmer index, the sphere (1:
+//!   the a1 sphere, 2: the a2 sphere) and the orientation N per particle, and the time in s.
+//!   Each frame is appended with one write the moment it is due, so a kill or Ctrl-C loses no
+//!   frame already written and never leaves half of one.
+//! - A ParaView series (`.pvd`): one VTK PolyData file (`.vtp`, written by the vtkio crate) per
+//!   frame in the folder `<name>_frames/` beside it, with the same data as point arrays (radius
+//!   and N for glyphs), and the `.pvd` collection listing every frame with its time, rewritten
+//!   whole (through a temporary file) after each frame.
+
+use super::error::{invalid, Result};
+use super::files::{ensure_parent, write_atomically, LineStream};
+use super::scene::Scene;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Metres to the files' µm.
+const UM: f64 = 1e6;
+
+/// The file formats, by the path's extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Extended XYZ.
+    Xyz,
+    /// A ParaView `.pvd` collection of `.vtp` frames.
+    Pvd,
+}
+
+/// A trajectory being written.
+#[derive(Debug)]
+pub struct Trajectory {
+    format: Format,
+    path: PathBuf,
+    /// The XYZ stream.
+    stream: Option<LineStream>,
+    /// Times and file names (relative to the `.pvd`) of the frames written.
+    frames: Vec<(f64, String)>,
+}
+
+impl Trajectory {
+    /// Start a trajectory at `path` (created or truncated): `.xyz` or `.pvd`.
+    pub fn create(path: &Path) -> Result<Self> {
+        let format = match path.extension().and_then(|e| e.to_str()) {
+            Some("xyz") => Format::Xyz,
+            Some("pvd") => Format::Pvd,
+            _ => {
+                return Err(invalid!(
+                    "trajectory {}: the file name must end in .xyz (extended XYZ, for ASE and OVITO) or .pvd (a ParaView series of .vtp frames)",
+                    path.display()
+                ))
+            }
+        };
+        let mut t = Trajectory {
+            format,
+            path: path.to_path_buf(),
+            stream: None,
+            frames: Vec::new(),
+        };
+        match format {
+            Format::Xyz => t.stream = Some(LineStream::create(path, &[])?),
+            Format::Pvd => {
+                let dir = t.frame_dir();
+                if dir.exists() {
+                    // Frames of an earlier trajectory of this name would mix with the new ones.
+                    std::fs::remove_dir_all(&dir).map_err(|e| {
+                        invalid!("cannot clear the old frames in {}: {e}", dir.display())
+                    })?;
+                }
+                t.write_collection()?;
+            }
+        }
+        Ok(t)
+    }
+
+    /// The format.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// Frames written so far.
+    pub fn frames(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Where the `.vtp` frames of a `.pvd` go: `<name>_frames/` beside it.
+    fn frame_dir(&self) -> PathBuf {
+        let stem = self
+            .path
+            .file_stem()
+            .map_or("trajectory".into(), |s| s.to_string_lossy().into_owned());
+        self.path.with_file_name(format!("{stem}_frames"))
+    }
+
+    /// Write the scene's spheres now as the next frame.
+    pub fn write_frame(&mut self, scene: &Scene) -> Result<()> {
+        let spheres = Spheres::of(scene);
+        match self.format {
+            Format::Xyz => {
+                let text = spheres.xyz(scene.time());
+                if let Some(s) = &mut self.stream {
+                    s.append(text.trim_end_matches('\n'))?;
+                }
+                self.frames.push((scene.time(), String::new()));
+            }
+            Format::Pvd => {
+                let dir = self.frame_dir();
+                let name = format!(
+                    "{}/frame_{:06}.vtp",
+                    dir.file_name().map_or("".into(), |d| d.to_string_lossy()),
+                    self.frames.len()
+                );
+                let file = self.path.with_file_name(&name);
+                ensure_parent(&file)?;
+                let bytes = spheres.vtp()?;
+                write_atomically(&file, |w| w.write_all(&bytes))?;
+                self.frames.push((scene.time(), name));
+                self.write_collection()?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The `.pvd` collection of the frames written so far.
+    fn write_collection(&self) -> Result<()> {
+        let mut xml = String::from(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+        );
+        for (t, name) in &self.frames {
+            let _ = writeln!(
+                xml,
+                "    <DataSet timestep=\"{t:?}\" group=\"\" part=\"0\" file=\"{}\"/>",
+                xml_escape(name)
+            );
+        }
+        xml.push_str("  </Collection>\n</VTKFile>\n");
+        write_atomically(&self.path, |w| w.write_all(xml.as_bytes()))
+    }
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// The spheres of a scene as a frame: positions and radii in µm, swimmer, sphere (1 or 2), N.
+struct Spheres {
+    pos: Vec<[f64; 3]>,
+    radius: Vec<f64>,
+    swimmer: Vec<i32>,
+    sphere: Vec<i32>,
+    dir: Vec<[f64; 3]>,
+}
+
+impl Spheres {
+    fn of(scene: &Scene) -> Self {
+        let n = 2 * scene.count();
+        let mut s = Spheres {
+            pos: Vec::with_capacity(n),
+            radius: Vec::with_capacity(n),
+            swimmer: Vec::with_capacity(n),
+            sphere: Vec::with_capacity(n),
+            dir: Vec::with_capacity(n),
+        };
+        for (i, d) in scene.swimmers().iter().enumerate() {
+            let (x1, x2) = scene.spheres(i);
+            let dir = (x2 - x1).normalize();
+            for (k, (x, a)) in [(x1, d.a1), (x2, d.a2)].into_iter().enumerate() {
+                s.pos.push([x.x * UM, x.y * UM, x.z * UM]);
+                s.radius.push(a * UM);
+                s.swimmer.push(i as i32);
+                s.sphere.push(k as i32 + 1);
+                s.dir.push([dir.x, dir.y, dir.z]);
+            }
+        }
+        s
+    }
+
+    /// One extended-XYZ frame (ends in a newline).
+    fn xyz(&self, time: f64) -> String {
+        let mut out = String::with_capacity(64 + 120 * self.pos.len());
+        let _ = writeln!(out, "{}", self.pos.len());
+        let _ = writeln!(
+            out,
+            "Properties=species:S:1:pos:R:3:radius:R:1:swimmer:I:1:sphere:I:1:N:R:3 Time={time:?} time_unit=s length_unit=um pbc=\"F F F\""
+        );
+        for k in 0..self.pos.len() {
+            let (p, d) = (self.pos[k], self.dir[k]);
+            let _ = writeln!(
+                out,
+                "X {:?} {:?} {:?} {:?} {} {} {:?} {:?} {:?}",
+                p[0], p[1], p[2], self.radius[k], self.swimmer[k], self.sphere[k], d[0], d[1], d[2]
+            );
+        }
+        out
+    }
+
+    /// One `.vtp` file: the spheres as vertices with point arrays radius, swimmer, sphere, N.
+    fn vtp(&self) -> Result<Vec<u8>> {
+        use vtkio::model::{
+            Attribute, Attributes, ByteOrder, DataArray, DataSet, PolyDataPiece, Version,
+            VertexNumbers, Vtk,
+        };
+        let n = self.pos.len();
+        let points: Vec<f64> = self.pos.iter().flatten().copied().collect();
+        let vtk = Vtk {
+            version: Version::new_xml(1, 0),
+            byte_order: ByteOrder::LittleEndian,
+            title: String::new(),
+            file_path: None,
+            data: DataSet::inline(PolyDataPiece {
+                points: points.into(),
+                verts: Some(VertexNumbers::XML {
+                    connectivity: (0..n as u64).collect(),
+                    offsets: (1..=n as u64).collect(),
+                }),
+                data: Attributes {
+                    point: vec![
+                        Attribute::DataArray(
+                            DataArray::scalars("radius", 1).with_data(self.radius.clone()),
+                        ),
+                        Attribute::DataArray(
+                            DataArray::scalars("swimmer", 1).with_data(self.swimmer.clone()),
+                        ),
+                        Attribute::DataArray(
+                            DataArray::scalars("sphere", 1).with_data(self.sphere.clone()),
+                        ),
+                        Attribute::DataArray(
+                            DataArray::vectors("N")
+                                .with_data(self.dir.iter().flatten().copied().collect::<Vec<_>>()),
+                        ),
+                    ],
+                    cell: Vec::new(),
+                },
+                ..Default::default()
+            }),
+        };
+        let file = vtkio::xml::VTKFile::try_from(vtk)
+            .map_err(|e| invalid!("cannot make a VTK frame: {e}"))?;
+        let mut bytes = Vec::new();
+        file.write(&mut bytes)
+            .map_err(|e| invalid!("cannot write a VTK frame: {e}"))?;
+        Ok(bytes)
+    }
+}

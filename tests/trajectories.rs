@@ -1,0 +1,250 @@
+//! Trajectories for particle viewers: extended XYZ read back by ASE (a real outside reader, in
+//! the Python environment `.ci/run` makes), the ParaView series read back by vtkio's parser, both
+//! sharing the recorders' triggers, and an XYZ stream that keeps every frame through `kill -9`.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+use swimlab::engine::{Scene, Simulation, Trigger};
+
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("swimlab-traj-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The sphere positions (µm), radii (µm) and swimmer indices of a scene, sphere by sphere.
+fn spheres_um(s: &Scene) -> Vec<([f64; 3], f64, usize)> {
+    (0..s.count())
+        .flat_map(|i| {
+            let (a, b) = s.spheres(i);
+            let d = s.swimmer(i).unwrap();
+            [(a, d.a1), (b, d.a2)].map(|(x, r)| ([x.x * 1e6, x.y * 1e6, x.z * 1e6], r * 1e6, i))
+        })
+        .collect()
+}
+
+/// A 3D scene (three swimmers out of line) run for one period with a trajectory every half
+/// period: three frames, at 0, T/2 and T. Returns the final scene and the frames' times.
+fn run_with_trajectory(path: &Path) -> (Scene, Vec<f64>) {
+    let mut s = common::mirror_inwards(10.0, true);
+    s.add(
+        swimlab::engine::Dumbbell::default(),
+        nalgebra::Vector3::new(0.0, 40e-6, 10e-6),
+        nalgebra::Vector3::new(0.3, 1.0, -0.5),
+    )
+    .unwrap();
+    let mut sim = Simulation::new(s);
+    let id = sim.trajectory(path, Trigger::EveryPeriods(0.5)).unwrap();
+    sim.run_periods(1.0).unwrap();
+    let times = sim
+        .recorder(id)
+        .unwrap()
+        .rows
+        .iter()
+        .map(|r| r[0])
+        .collect();
+    (sim.into_scene(), times)
+}
+
+/// A Python with ASE: `SWIMLAB_PYTHON`, else the `.venv` that `.ci/run` makes. Without one the
+/// ASE test is skipped with a message, unless `SWIMLAB_REQUIRE_ASE=1` (CI) makes that a failure.
+fn python_with_ase() -> Option<PathBuf> {
+    let candidates = [
+        std::env::var_os("SWIMLAB_PYTHON").map(PathBuf::from),
+        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python")),
+    ];
+    let found = candidates.into_iter().flatten().find(|p| {
+        Command::new(p)
+            .args(["-c", "import ase.io"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var("SWIMLAB_REQUIRE_ASE").as_deref() != Ok("1"),
+            "SWIMLAB_REQUIRE_ASE=1 but no Python with ASE (set SWIMLAB_PYTHON or run .ci/run)"
+        );
+        eprintln!(
+            "skipped: no Python with ASE (python3 -m venv .venv && .venv/bin/pip install ase)"
+        );
+    }
+    found
+}
+
+#[test]
+fn ase_reads_the_extended_xyz_back() {
+    let Some(python) = python_with_ase() else {
+        return;
+    };
+    let d = dir("ase");
+    let path = d.join("pair.xyz");
+    let (scene, times) = run_with_trajectory(&path);
+    assert_eq!(times.len(), 3);
+    let out = Command::new(python)
+        .args([
+            "-c",
+            "import ase.io, json, sys\n\
+             frames = ase.io.read(sys.argv[1], index=':')\n\
+             print(json.dumps([{'pos': f.positions.tolist(), 'radius': f.arrays['radius'].tolist(), \
+             'swimmer': f.arrays['swimmer'].tolist(), 'N': f.arrays['N'].tolist(), 'time': f.info['Time']} \
+             for f in frames]))",
+            path.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "ASE failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let frames: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let frames = frames.as_array().unwrap();
+    assert_eq!(frames.len(), 3, "three frames");
+    for (f, t) in frames.iter().zip(&times) {
+        assert_eq!(f["time"].as_f64().unwrap(), *t);
+        assert_eq!(f["pos"].as_array().unwrap().len(), 2 * scene.count());
+    }
+    // The last frame is the final state: positions and radii exactly (the shortest round-trip
+    // text of each f64), swimmer indices and unit orientations.
+    let last = &frames[2];
+    for (k, (p, r, i)) in spheres_um(&scene).iter().enumerate() {
+        let got: Vec<f64> = last["pos"][k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert_eq!(got, p.to_vec(), "sphere {k}");
+        assert_eq!(last["radius"][k].as_f64().unwrap(), *r);
+        assert_eq!(last["swimmer"][k].as_u64().unwrap() as usize, *i);
+        let n = scene.dir(*i).unwrap();
+        for c in 0..3 {
+            assert!((last["N"][k][c].as_f64().unwrap() - n[c]).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn the_paraview_series_reads_back() {
+    let d = dir("pvd");
+    let path = d.join("pair.pvd");
+    let (scene, times) = run_with_trajectory(&path);
+    let pvd = std::fs::read_to_string(&path).unwrap();
+    let files: Vec<&str> = pvd
+        .lines()
+        .filter_map(|l| l.split("file=\"").nth(1))
+        .map(|rest| rest.split('"').next().unwrap())
+        .collect();
+    assert_eq!(files.len(), 3);
+    for t in &times {
+        assert!(pvd.contains(&format!("timestep=\"{t:?}\"")), "{pvd}");
+    }
+    let last = vtkio::Vtk::import(d.join(files[2])).expect("vtkio parses the frame");
+    let vtkio::model::DataSet::PolyData { pieces, .. } = last.data else {
+        panic!("a PolyData frame");
+    };
+    let vtkio::model::Piece::Inline(piece) = &pieces[0] else {
+        panic!("an inline piece");
+    };
+    let points: Vec<f64> = piece.points.cast_into().unwrap();
+    let want = spheres_um(&scene);
+    assert_eq!(points.len(), 3 * want.len());
+    for (k, (p, ..)) in want.iter().enumerate() {
+        assert_eq!(&points[3 * k..3 * k + 3], p, "point {k}");
+    }
+    let names: Vec<&str> = piece.data.point.iter().map(|a| a.name()).collect();
+    assert_eq!(names, ["radius", "swimmer", "sphere", "N"]);
+    let vtkio::model::Attribute::DataArray(radius) = &piece.data.point[0] else {
+        panic!("radius is an array");
+    };
+    let radii: Vec<f64> = radius.data.clone().cast_into().unwrap();
+    assert_eq!(radii, want.iter().map(|w| w.1).collect::<Vec<_>>());
+}
+
+#[test]
+fn a_bad_trajectory_name_is_refused() {
+    let mut sim = Simulation::new(common::mirror_inwards(10.0, true));
+    let e = sim
+        .trajectory(Path::new("out/t.dcd"), Trigger::EveryPeriods(1.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("must end in .xyz") && e.contains(".pvd"), "{e}");
+}
+
+/// Frames in an XYZ file, and whether it ends exactly after a whole frame.
+fn whole_frames(text: &str) -> (usize, bool) {
+    let lines: Vec<&str> = text.lines().collect();
+    let (mut i, mut frames) = (0, 0);
+    while i < lines.len() {
+        let Ok(n) = lines[i].trim().parse::<usize>() else {
+            return (frames, false);
+        };
+        if i + 2 + n > lines.len() {
+            return (frames, false);
+        }
+        assert!(
+            lines[i + 1].contains("Properties="),
+            "comment line of frame {frames}"
+        );
+        assert!(lines[i + 2..i + 2 + n]
+            .iter()
+            .all(|l| l.split(' ').count() == 10));
+        i += 2 + n;
+        frames += 1;
+    }
+    (frames, text.ends_with('\n'))
+}
+
+/// `kill -9` during a run leaves every frame already due whole: the file ends after a frame.
+#[test]
+fn kill_9_keeps_every_frame_already_written() {
+    let d = dir("kill9");
+    let xyz = d.join("long.xyz");
+    let script = d.join("long.rhai");
+    std::fs::write(
+        &script,
+        format!(
+            "import \"paper\" as paper;\nlet s = paper::mirror(10.0, true, true);\ns.trajectory(\"{}\", every_periods(0.05));\ns.run_periods(100000);\n",
+            xyz.display()
+        ),
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", script.to_str().unwrap()])
+        .env("SWIMLAB_PROGRESS", "0")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let seen = loop {
+        let (frames, _) = whole_frames(&std::fs::read_to_string(&xyz).unwrap_or_default());
+        if frames >= 5 {
+            break frames;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no frames written"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(Command::new("kill")
+        .args(["-9", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let _ = child.wait();
+    let (frames, whole) = whole_frames(&std::fs::read_to_string(&xyz).unwrap());
+    assert!(whole, "the file ends inside a frame");
+    assert!(
+        frames >= seen,
+        "{frames} frames after the kill, {seen} seen before"
+    );
+}
