@@ -12,3 +12,4 @@ pub mod engine;
 pub mod plot;
 pub mod repl;
 pub mod script;
+pub mod sweep;

@@ -49,6 +49,37 @@ enum Command {
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
     },
+    /// Run SCRIPT for every point of a parameter grid, each point in its own folder DIR/<index>/
+    /// (its working directory: its files, stdout.txt, stderr.txt, status.txt there), as
+    /// `swimlab run SCRIPT --set NAME=VALUE ...`; DIR/index.csv lists index, parameters, status
+    /// and wall time. A failed point is reported and does not stop the others.
+    Sweep {
+        /// The experiment script.
+        script: PathBuf,
+        /// A parameter and its values, e.g. --grid D=5,10,20 (repeat for more; the last varies
+        /// fastest).
+        #[arg(long = "grid", value_name = "NAME=V1,V2,...", required = true)]
+        grid: Vec<String>,
+        /// The output folder.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Processes at once (default: one per core).
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Skip the points that already finished (status ok).
+        #[arg(long)]
+        resume: bool,
+        /// Write DIR/sweep.sbatch, a SLURM job array whose task k runs point k exactly as the
+        /// local sweep would, instead of running.
+        #[arg(long)]
+        slurm: bool,
+        /// Run each point's quick variant.
+        #[arg(long)]
+        quick: bool,
+        /// Run point K only (what a SLURM array task does).
+        #[arg(long, value_name = "K")]
+        task: Option<usize>,
+    },
     /// Render every figure of the paper (scripts/paper, built in): CSV and PNG to out/paper/,
     /// and the PNGs also to --out if given (e.g. docs/figures for the README).
     MakeFigures {
@@ -105,6 +136,38 @@ fn main() -> ExitCode {
         match cli.command {
             Some(Command::Bench { which, quick }) => {
                 swimlab::bench::report::run(which.into(), quick)
+            }
+            Some(Command::Sweep {
+                script,
+                grid,
+                out,
+                jobs,
+                resume,
+                slurm,
+                quick,
+                task,
+            }) => {
+                swimlab::script::interrupt::install_batch_handler();
+                grid.iter()
+                    .map(|g| swimlab::sweep::Axis::parse(g))
+                    .collect::<Result<Vec<_>, String>>()
+                    .and_then(|axes| {
+                        let sweep = swimlab::sweep::Sweep {
+                            script,
+                            axes,
+                            out,
+                            jobs: jobs.unwrap_or_else(|| {
+                                std::thread::available_parallelism().map_or(1, |n| n.get())
+                            }),
+                            resume,
+                            quick,
+                        };
+                        match (task, slurm) {
+                            (Some(k), _) => sweep.run_task(k),
+                            (None, true) => sweep.write_slurm(),
+                            (None, false) => sweep.run_local(),
+                        }
+                    })
             }
             Some(Command::MakeFigures { quick, out }) => {
                 swimlab::script::interrupt::install_batch_handler();
