@@ -86,6 +86,78 @@ fn png_has_the_size_and_every_series() {
     assert!(pixels_of(&rgb, (0, 0, 0)) > 500);
 }
 
+/// A legend "outside" sits right of the plot: every series' swatch is drawn in the strip beyond
+/// the plot's right edge, where no data can be (the data span the plot only).
+#[test]
+fn an_outside_legend_is_drawn_beside_the_data() {
+    let mut f = figure(3);
+    f.legend = swimlab::plot::Legend::Outside;
+    let path = dir("outside").join("p.png");
+    f.save(&path).unwrap();
+    let (w, h, rgb) = read_png(&path);
+    // The legend strip: the right 120 px (the legend area of 8-character labels is 122 px).
+    let strip: Vec<u8> = (0..h as usize)
+        .flat_map(|y| {
+            let row = &rgb[3 * (y * w as usize)..3 * ((y + 1) * w as usize)];
+            row[3 * (w as usize - 120)..].to_vec()
+        })
+        .collect();
+    for (k, c) in COLORS[..3].iter().enumerate() {
+        assert!(
+            pixels_of(&strip, *c) > 5,
+            "series {k}'s swatch is not beside the plot"
+        );
+    }
+    assert!(swimlab::plot::Legend::parse("outside").is_ok());
+    let e = swimlab::plot::Legend::parse("outsde").unwrap_err();
+    assert!(e.contains("\"outside\""), "{e}");
+}
+
+/// `s.animate` writes an animated GIF: frames + 1 frames of the snapshot's size, each different
+/// from the one before (eighths of a stroke: the length L(t) differs from one to the next), and
+/// the scene ran the periods asked.
+#[test]
+fn animate_writes_a_gif_of_the_run() {
+    let d = dir("animate");
+    let path = d.join("pair.gif");
+    let script = format!(
+        "let s = scene(); s.add(dumbbell(#{{ a1: 1.125e-6, a2: 0.5625e-6 }})); let n = s.animate(\"{}\", #{{ periods: 1, frames: 8, width: 300, height: 240 }}); print(n); print(s.time / s.period);",
+        path.display()
+    );
+    let out = swimlab(&["-e", &script], &d);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "9", "9 frames: {text}");
+    let periods: f64 = lines[1].parse().unwrap();
+    assert!((periods - 1.0).abs() < 1e-12, "one period run: {periods}");
+    let mut opts = gif::DecodeOptions::new();
+    opts.set_color_output(gif::ColorOutput::RGBA);
+    let mut dec = opts.read_info(std::fs::File::open(&path).unwrap()).unwrap();
+    assert_eq!((dec.width(), dec.height()), (300, 240));
+    let mut frames: Vec<Vec<u8>> = Vec::new();
+    while let Some(f) = dec.read_next_frame().unwrap() {
+        frames.push(f.buffer.to_vec());
+    }
+    assert_eq!(frames.len(), 9);
+    assert!(
+        frames.windows(2).all(|w| w[0] != w[1]),
+        "every frame shows the stroke moving on"
+    );
+    let bad = swimlab(
+        &[
+            "-e",
+            "let s = scene(); s.add(dumbbell()); s.animate(\"a.png\");",
+        ],
+        &d,
+    );
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("give a path ending in .gif"));
+}
+
 #[test]
 fn bad_figures_are_refused_with_the_fix() {
     let mut f = figure(1);

@@ -10,7 +10,7 @@ mod render;
 mod snapshot;
 mod text;
 
-pub use snapshot::{snapshot, Plane, SnapshotOptions};
+pub use snapshot::{snapshot, Plane, SceneFilm, SnapshotOptions};
 pub use text::render_text;
 
 /// How a series is drawn.
@@ -103,22 +103,25 @@ pub enum Legend {
     LowerRight,
     /// Bottom left.
     LowerLeft,
+    /// Right of the plot, outside the data.
+    Outside,
     /// No legend.
     None,
 }
 
 impl Legend {
-    /// Parse "upper right", "upper left", "lower right", "lower left" or "none".
+    /// Parse "upper right", "upper left", "lower right", "lower left", "outside" or "none".
     pub fn parse(name: &str) -> Result<Self, String> {
         Ok(match name {
             "upper right" => Legend::UpperRight,
             "upper left" => Legend::UpperLeft,
             "lower right" => Legend::LowerRight,
             "lower left" => Legend::LowerLeft,
+            "outside" => Legend::Outside,
             "none" => Legend::None,
             other => {
                 return Err(format!(
-                    "unknown legend place \"{other}\"; use \"upper right\", \"upper left\", \"lower right\", \"lower left\" or \"none\""
+                    "unknown legend place \"{other}\"; use \"upper right\", \"upper left\", \"lower right\", \"lower left\", \"outside\" (right of the plot) or \"none\""
                 ))
             }
         })
@@ -164,8 +167,15 @@ pub fn format_number(v: f64, span: f64) -> String {
             s
         }
     } else {
+        // Trailing zeros of the mantissa go as in the decimal form: 2e-5, not 2.0e-5.
         let d = digits.saturating_sub(1);
-        format!("{v:.d$e}")
+        let s = format!("{v:.d$e}");
+        match s.split_once('e') {
+            Some((m, e)) if m.contains('.') => {
+                format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            _ => s,
+        }
     }
 }
 
@@ -336,5 +346,18 @@ impl Figure {
             let w = if lo == 0.0 { 1.0 } else { 0.05 * lo.abs() };
             (lo - w, hi + w)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::format_number;
+
+    #[test]
+    fn tick_labels_drop_trailing_zeros_in_both_forms() {
+        assert_eq!(format_number(2e-5, 1.1e-4), "2e-5");
+        assert_eq!(format_number(1e-5, 1.1e-4), "1e-5");
+        assert_eq!(format_number(2.5e-5, 1.1e-5), "2.5e-5");
+        assert_eq!(format_number(0.5, 1.0), "0.5");
     }
 }

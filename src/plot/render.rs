@@ -71,12 +71,104 @@ fn color(k: usize) -> RGBColor {
     RGBColor(r, g, b)
 }
 
+/// The labels of a figure's legend, with each entry's series.
+fn legend_entries(f: &Figure) -> Vec<(usize, &super::Series)> {
+    f.series
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| !s.label.is_empty())
+        .collect()
+}
+
+/// Width (px) of a legend outside the plot: the longest label at ~7.8 px a character (DejaVu
+/// Sans at 14 px), the swatch and margins; at most 40% of the picture.
+fn outside_legend_width(f: &Figure) -> u32 {
+    let longest = legend_entries(f)
+        .iter()
+        .map(|(_, s)| s.label.chars().count())
+        .max()
+        .unwrap_or(0);
+    ((longest as f64 * 7.8) as u32 + 60).min(f.width * 2 / 5)
+}
+
+/// Draw the legend entries in `area`, top down, from `top` px.
+fn draw_outside_legend<DB: DrawingBackend>(
+    f: &Figure,
+    area: &DrawingArea<DB, Shift>,
+    top: i32,
+) -> Result<(), String> {
+    for (row, (k, s)) in legend_entries(f).into_iter().enumerate() {
+        let c = color(s.color.unwrap_or(k));
+        let y = top + 22 * row as i32;
+        match s.style {
+            Style::Line => area
+                .draw(&PathElement::new(vec![(6, y), (30, y)], c.stroke_width(2)))
+                .map_err(err)?,
+            Style::Points => area
+                .draw(&Circle::new((18, y), 4, c.filled()))
+                .map_err(err)?,
+        }
+        let style = TextStyle::from(("sans-serif", 14).into_font()).pos(
+            plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Left,
+                plotters::style::text_anchor::VPos::Center,
+            ),
+        );
+        area.draw(&Text::new(s.label.clone(), (38, y), style))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Ticks of a log axis over [a, b]: labelled (bold) at 1, 2, 3 and 5 × 10^k on an axis of up to
+/// 2 decades, 1, 2 and 5 × 10^k up to 3, 10^k alone beyond (every third power beyond 12); light
+/// lines at every m × 10^k.
+fn log_ticks(a: f64, b: f64) -> (Vec<f64>, Vec<f64>) {
+    let (lo, hi) = (a.min(b), a.max(b));
+    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let decades = (hi / lo).log10();
+    let every = if decades > 12.0 { 3 } else { 1 };
+    let (mut bold, mut light) = (Vec::new(), Vec::new());
+    for k in k0..=k1 {
+        let p = 10f64.powi(k);
+        for m in 1..10 {
+            let v = m as f64 * p;
+            if v < lo * (1.0 - 1e-12) || v > hi * (1.0 + 1e-12) {
+                continue;
+            }
+            light.push(v);
+            let labelled = match m {
+                1 => k % every == 0,
+                2 | 5 => decades <= 3.0,
+                3 => decades <= 2.0,
+                _ => false,
+            };
+            if labelled {
+                bold.push(v);
+            }
+        }
+    }
+    (bold, light)
+}
+
 fn draw_figure<DB: DrawingBackend>(
     f: &Figure,
     root: &DrawingArea<DB, Shift>,
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(err)?;
     let f = &f.with_offsets();
+    if f.legend == Legend::Outside && !legend_entries(f).is_empty() {
+        let w = outside_legend_width(f);
+        let (plot_area, legend_area) = root.split_horizontally(f.width - w);
+        draw_axes(f, &plot_area)?;
+        let top = if f.title.is_empty() { 24 } else { 52 };
+        return draw_outside_legend(f, &legend_area, top);
+    }
+    draw_axes(f, root)
+}
+
+/// The axes, the series and (inside the plot) the legend.
+fn draw_axes<DB: DrawingBackend>(f: &Figure, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
     // Ranges are padded in the axis's own scale (log10 on a log axis), then mapped back.
     let axis = |x_axis: bool, log: bool| {
         let (a, b) = f.range(x_axis);
@@ -87,11 +179,18 @@ fn draw_figure<DB: DrawingBackend>(
         }
     };
     let ((x0, x1), (y0, y1)) = (axis(true, f.log_x), axis(false, f.log_y));
+    let logged = |a: f64, b: f64| {
+        let (bold, light) = log_ticks(a, b);
+        (a..b)
+            .log_scale()
+            .with_key_points(bold)
+            .with_light_points(light)
+    };
     match (f.log_x, f.log_y) {
         (false, false) => draw_in(f, root, x0..x1, y0..y1),
-        (true, false) => draw_in(f, root, (x0..x1).log_scale(), y0..y1),
-        (false, true) => draw_in(f, root, x0..x1, (y0..y1).log_scale()),
-        (true, true) => draw_in(f, root, (x0..x1).log_scale(), (y0..y1).log_scale()),
+        (true, false) => draw_in(f, root, logged(x0, x1), y0..y1),
+        (false, true) => draw_in(f, root, x0..x1, logged(y0, y1)),
+        (true, true) => draw_in(f, root, logged(x0, x1), logged(y0, y1)),
     }
 }
 
@@ -157,7 +256,7 @@ where
         Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
         Legend::LowerRight => SeriesLabelPosition::LowerRight,
         Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
-        Legend::None => return Ok(()),
+        Legend::Outside | Legend::None => return Ok(()),
     };
     if f.series.iter().any(|s| !s.label.is_empty()) {
         chart
@@ -187,6 +286,33 @@ pub(super) struct ScenePicture<'a> {
     pub size: (u32, u32),
     pub discs: Vec<Disc>,
     pub rods: Vec<(usize, usize)>,
+    /// The region shown, (x0, x1, y0, y1) in µm; `None`: the discs' extent, padded.
+    pub view: Option<(f64, f64, f64, f64)>,
+}
+
+/// An animated GIF of scene pictures, a frame per [`Film::frame`].
+pub(super) struct Film {
+    root: DrawingArea<BitMapBackend<'static>, Shift>,
+}
+
+impl Film {
+    /// A GIF at `path`, `size` pixels, `delay_ms` between frames.
+    pub(super) fn create(path: &Path, size: (u32, u32), delay_ms: u32) -> Result<Self, String> {
+        register_font();
+        let backend = BitMapBackend::gif(path, size, delay_ms).map_err(|e| {
+            format!("cannot write the picture: {e}; check that the folder exists and is writable")
+        })?;
+        Ok(Film {
+            root: backend.into_drawing_area(),
+        })
+    }
+
+    /// Draw `p` as the next frame; returns the region it showed (to hold it for the next ones).
+    pub(super) fn frame(&mut self, p: &ScenePicture) -> Result<(f64, f64, f64, f64), String> {
+        let view = draw_scene(p, &self.root)?;
+        self.root.present().map_err(err)?;
+        Ok(view)
+    }
 }
 
 /// Draw a scene picture to `path`.
@@ -206,11 +332,19 @@ pub(super) fn scene(p: &ScenePicture, path: &Path, format: Format) -> Result<(),
     }
 }
 
+/// Draw `p`; returns the region shown (x0, x1, y0, y1) in µm.
 fn draw_scene<DB: DrawingBackend>(
     p: &ScenePicture,
     root: &DrawingArea<DB, Shift>,
-) -> Result<(), String> {
+) -> Result<(f64, f64, f64, f64), String> {
     root.fill(&WHITE).map_err(err)?;
+    let (x0, x1, y0, y1) = p.view.unwrap_or_else(|| scene_view(p));
+    draw_scene_in(p, root, (x0, x1, y0, y1))?;
+    Ok((x0, x1, y0, y1))
+}
+
+/// The discs' extent, padded by 5% and widened to the plotting area's aspect ratio (equal scales).
+pub(super) fn scene_view(p: &ScenePicture) -> (f64, f64, f64, f64) {
     let (mut x0, mut x1, mut y0, mut y1) = p.discs.iter().fold(
         (
             f64::INFINITY,
@@ -244,6 +378,15 @@ fn draw_scene<DB: DrawingBackend>(
         let extra = (w * ah / aw - h) / 2.0;
         (y0, y1) = (y0 - extra, y1 + extra);
     }
+    (x0, x1, y0, y1)
+}
+
+fn draw_scene_in<DB: DrawingBackend>(
+    p: &ScenePicture,
+    root: &DrawingArea<DB, Shift>,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+) -> Result<(), String> {
+    let (xl, yl, margin) = (45.0, 70.0, 14.0);
     let mut builder = ChartBuilder::on(root);
     builder
         .margin(margin as u32)
@@ -284,4 +427,23 @@ fn draw_scene<DB: DrawingBackend>(
             .map_err(err)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::log_ticks;
+
+    #[test]
+    fn log_axes_label_one_two_three_five() {
+        let (bold, light) = log_ticks(2.7, 33.0);
+        assert_eq!(bold, vec![3.0, 5.0, 10.0, 20.0, 30.0]);
+        assert_eq!(light.len(), 10, "3 … 9, 10, 20, 30: {light:?}");
+        let (bold, _) = log_ticks(0.5, 500.0);
+        assert_eq!(
+            bold,
+            vec![0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0]
+        );
+        let (bold, _) = log_ticks(1e-3, 1e5);
+        assert_eq!(bold.len(), 9, "powers of ten only over 8 decades: {bold:?}");
+    }
 }

@@ -74,6 +74,65 @@ pub const MAX_EXTENT_IN_RADII: f64 = 1e9;
 /// Draw `scene` to `path` (SVG or PNG by extension); folders are created.
 pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<(), String> {
     let format = Format::of(path)?;
+    let picture = picture(scene, opts)?;
+    crate::engine::files::ensure_parent(path).map_err(|e| e.to_string())?;
+    render::scene(&picture, path, format)
+}
+
+/// An animated GIF of a scene as it runs: a frame per [`SceneFilm::frame`], every frame showing
+/// the region of the first (so the picture holds still while the swimmers move).
+pub struct SceneFilm {
+    film: render::Film,
+    opts: SnapshotOptions,
+    view: Option<(f64, f64, f64, f64)>,
+    frames: usize,
+}
+
+impl SceneFilm {
+    /// A GIF at `path` (it must end in .gif; folders are created), `fps` frames a second.
+    pub fn create(path: &Path, opts: &SnapshotOptions, fps: f64) -> Result<Self, String> {
+        if path.extension().and_then(|e| e.to_str()) != Some("gif") {
+            return Err(format!(
+                "{}: an animation is written as GIF: give a path ending in .gif",
+                path.display()
+            ));
+        }
+        if !(fps.is_finite() && (0.5..=100.0).contains(&fps)) {
+            return Err(format!("fps must be 0.5 to 100 frames a second, got {fps}"));
+        }
+        check_size(opts)?;
+        crate::engine::files::ensure_parent(path).map_err(|e| e.to_string())?;
+        Ok(SceneFilm {
+            film: render::Film::create(path, (opts.width, opts.height), (1000.0 / fps) as u32)?,
+            opts: opts.clone(),
+            view: None,
+            frames: 0,
+        })
+    }
+
+    /// Draw the scene now as the next frame (written to the file at once).
+    pub fn frame(&mut self, scene: &Scene) -> Result<(), String> {
+        let mut p = picture(scene, &self.opts)?;
+        if let Some(v) = self.view {
+            p.view = Some(v);
+        } else {
+            // Hold the first frame's region, widened by a fifth for the motion to come.
+            let (x0, x1, y0, y1) = render::scene_view(&p);
+            let (dx, dy) = (0.1 * (x1 - x0), 0.1 * (y1 - y0));
+            p.view = Some((x0 - dx, x1 + dx, y0 - dy, y1 + dy));
+        }
+        self.view = Some(self.film.frame(&p)?);
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Frames written.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+}
+
+fn check_size(opts: &SnapshotOptions) -> Result<(), String> {
     for (w, what) in [(opts.width, "width"), (opts.height, "height")] {
         if !(100..=8000).contains(&w) {
             return Err(format!(
@@ -81,6 +140,12 @@ pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<()
             ));
         }
     }
+    Ok(())
+}
+
+/// The picture of `scene`: discs and rods in µm, nearer swimmers last.
+fn picture<'a>(scene: &Scene, opts: &'a SnapshotOptions) -> Result<ScenePicture<'a>, String> {
+    check_size(opts)?;
     if scene.count() == 0 {
         return Err("the scene has no swimmers to draw; add some first".into());
     }
@@ -128,17 +193,13 @@ pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<()
             (hi - lo) / um
         ));
     }
-    let names = ["x [µm]", "y [µm]", "z [µm]"];
-    crate::engine::files::ensure_parent(path).map_err(|e| e.to_string())?;
-    render::scene(
-        &ScenePicture {
-            title: &opts.title,
-            axes: (names[a], names[b]),
-            size: (opts.width, opts.height),
-            discs,
-            rods,
-        },
-        path,
-        format,
-    )
+    const NAMES: [&str; 3] = ["x [µm]", "y [µm]", "z [µm]"];
+    Ok(ScenePicture {
+        title: &opts.title,
+        axes: (NAMES[a], NAMES[b]),
+        size: (opts.width, opts.height),
+        discs,
+        rods,
+        view: None,
+    })
 }

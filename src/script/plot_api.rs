@@ -5,12 +5,14 @@
 //! (x defaults to 0, 1, 2, ...; color to the series' index in the palette); options are a
 //! map `#{ title, x_label, y_label, log_x, log_y, width, height }` (and `cols`, `rows` for text).
 
-use super::convert::{number, script_error, ScriptResult};
+use super::convert::{lift, number, script_error, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
 use super::scene_api::SceneHandle;
-use crate::plot::{render_text, snapshot, Figure, Legend, Plane, Series, SnapshotOptions, Style};
-use rhai::{Array, Dynamic, Engine, Map};
+use crate::plot::{
+    render_text, snapshot, Figure, Legend, Plane, SceneFilm, Series, SnapshotOptions, Style,
+};
+use rhai::{Array, Dynamic, Engine, Map, INT};
 
 fn numbers(what: &str, v: &Dynamic) -> ScriptResult<Vec<f64>> {
     let arr = v
@@ -246,8 +248,79 @@ fn snapshot_options(opts: &Map) -> ScriptResult<SnapshotOptions> {
     Ok(o)
 }
 
+/// Most frames one animation may have (a GIF of 700×600 frames is ~100 KB a frame).
+const MAX_FRAMES: i64 = 2000;
+
+/// `s.animate(path, #{ periods, frames, fps, plane, title, width, height })`: run the scene for
+/// `periods` periods and write `frames` + 1 pictures (the first now, then one per equal slice of
+/// the run) to an animated GIF. Recorders fire as in any run; an error or Ctrl-C stops the run
+/// and leaves the frames so far in a valid GIF.
+fn animate(s: &mut SceneHandle, path: &str, opts: &Map) -> ScriptResult<INT> {
+    let (mut periods, mut frames, mut fps) = (1.0, 24_i64, 12.0);
+    let mut rest = Map::new();
+    for (key, v) in opts {
+        match key.as_str() {
+            "periods" => periods = number("animate: periods", v)?,
+            "frames" => {
+                frames = v.as_int().map_err(|_| {
+                    script_error(format!("animate: frames must be a whole number, got {v}"))
+                })?
+            }
+            "fps" => fps = number("animate: fps", v)?,
+            _ => {
+                rest.insert(key.clone(), v.clone());
+            }
+        }
+    }
+    if !(1..=MAX_FRAMES).contains(&frames) {
+        return Err(script_error(format!(
+            "animate: frames must be 1 to {MAX_FRAMES}, got {frames}"
+        )));
+    }
+    if !(periods.is_finite() && periods > 0.0) {
+        return Err(script_error(format!(
+            "animate: periods must be a positive number, got {periods}"
+        )));
+    }
+    let o = snapshot_options(&rest).map_err(|e| {
+        script_error(format!(
+            "animate: {}; or periods, frames, fps",
+            e.to_string()
+                .trim_end_matches(|c: char| c == ')' || c.is_whitespace())
+        ))
+    })?;
+    let duration = periods * lift(s.borrow().period())?;
+    let mut film = SceneFilm::create(std::path::Path::new(path), &o, fps)
+        .map_err(|e| script_error(format!("animate \"{path}\": {e}")))?;
+    let t0 = s.borrow().time();
+    for k in 0..=frames {
+        if k > 0 {
+            // Frame k at t0 + k/frames of the run: no rounding accumulates over the frames.
+            let target = t0 + duration * k as f64 / frames as f64;
+            let now = s.borrow().time();
+            lift(s.borrow_mut().run((target - now).max(0.0)))?;
+        }
+        film.frame(&s.borrow())
+            .map_err(|e| script_error(format!("animate \"{path}\": {e}")))?;
+    }
+    Ok(film.frames() as INT)
+}
+
 /// Register the picture functions.
 pub fn register(engine: &mut Engine) {
+    engine
+        .register_fn(
+            "animate",
+            |s: &mut SceneHandle, path: &str| -> ScriptResult<INT> {
+                animate(s, path, &Map::new())
+            },
+        )
+        .register_fn(
+            "animate",
+            |s: &mut SceneHandle, path: &str, opts: Map| -> ScriptResult<INT> {
+                animate(s, path, &opts)
+            },
+        );
     engine
         .register_fn("plot", |path: &str, series: Dynamic| {
             plot(path, &series, &Map::new())
@@ -315,5 +388,6 @@ pub fn register(engine: &mut Engine) {
 pub(super) const DOCS: &[Doc] = &[
     doc_entry!("plot", "pictures", "plot(path, series)\nplot(path, series, #{ title, x_label, y_label, log_x, log_y, width, height })\nrec.plot(path, x_column, y_columns)\nrec.plot(path, x_column, y_columns, options)", "Draw series to an SVG or PNG file (by the extension; folders are created). A series is #{ x: [..], y: [..], label: \"..\", style: \"line\" | \"points\" }; give one map or an array of them. rec.plot draws recorded columns against one column, with their units as labels. Text uses an embedded font: no system fonts needed.", "plot(\"out/help/p.svg\", [#{ x: [1, 2, 3], y: [1, 4, 9], label: \"x^2\" }, #{ x: [1, 2, 3], y: [1, 8, 27], label: \"x^3\", style: \"points\" }], #{ title: \"powers\", x_label: \"x\", y_label: \"y\", log_y: true });"),
     doc_entry!("tplot", "pictures", "tplot(series)\ntplot(series, options)\nrec.tplot(x_column, y_columns)\nrec.tplot(x_column, y_columns, options)", "A quick plot as text in the terminal: series and options as for plot, plus cols and rows (the plot area in characters, default 72 x 18).", "tplot(#{ x: [0, 1, 2, 3], y: [0, 1, 4, 9], label: \"x^2\" }, #{ cols: 40, rows: 8 });"),
+    doc_entry!("animate", "pictures", "s.animate(path) -> int\ns.animate(path, #{ periods, frames, fps, plane, title, width, height }) -> int", "Run the scene for periods periods (default 1) and write an animated GIF of it: the picture of s.snapshot now and after each of frames equal slices of the run (default 24; at most 2000), fps frames a second (default 12), every frame showing the first frame's region. The run is a run like any other: the scene moves on and recorders fire; Ctrl-C stops it and the frames so far stay a valid GIF. Returns the number of frames.", "let s = scene(); s.add(dumbbell(#{ a1: 1.125e-6, a2: 0.5625e-6 })); print(s.animate(\"out/help/stroke.gif\", #{ periods: 1, frames: 8 }));"),
     doc_entry!("snapshot", "pictures", "s.snapshot(path)\ns.snapshot(path, #{ plane: \"xy\" | \"xz\" | \"yz\", title, width, height })", "A picture of the scene (SVG or PNG): every swimmer's spheres at their radii and its rod, projected on a plane, coloured by the in-plane direction of N (aligned swimmers share a colour; out-of-plane ones fade to grey). Call it in a loop for the frames of an animation.", "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [12e-6, 3e-6, 0], dir: [0, 1, 0] })); s.snapshot(\"out/help/scene.png\", #{ title: \"two swimmers\" });"),
 ];
