@@ -304,7 +304,11 @@ impl Sweep {
     }
 
     /// `index.csv` from the points' status files (written whole, through a temporary file).
+    /// Array tasks finishing together each rewrite it: they take turns through a lock file, so
+    /// the last one to write has read every status written before it (each task writes its own
+    /// status first).
     fn write_index(&self, points: &[Vec<(String, String)>]) -> Result<(), String> {
+        let _turn = IndexTurn::take(&self.out.join(".index.lock"));
         let path = self.out.join("index.csv");
         crate::engine::files::write_atomically(&path, |w| {
             let mut csv = csv::Writer::from_writer(w);
@@ -349,6 +353,32 @@ impl Sweep {
                     .join(", ")
             ))
         }
+    }
+}
+
+/// A turn at writing index.csv: the lock file exists while it is held (created exclusively,
+/// removed on drop). A lock older than the wait (a task killed while writing) is taken over.
+struct IndexTurn(PathBuf);
+
+impl IndexTurn {
+    fn take(lock: &Path) -> Self {
+        let start = Instant::now();
+        while std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(lock)
+            .is_err()
+            && start.elapsed() < std::time::Duration::from_secs(10)
+        {
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        IndexTurn(lock.to_path_buf())
+    }
+}
+
+impl Drop for IndexTurn {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
     }
 }
 

@@ -236,3 +236,55 @@ fn bad_grids_are_refused_with_the_fix() {
         assert!(text.contains(fragment), "{args:?}: {text}");
     }
 }
+
+/// With a SLURM cluster at hand (`.ci/run` starts a one-node one with `.ci/slurm-up` and sets
+/// SWIMLAB_SLURM=1), the job script is submitted for real: `sbatch --wait` runs the array, and
+/// every point's files equal the local sweep's, index.csv complete. Without one it is skipped
+/// with a message (the test above runs the tasks as SLURM would).
+#[test]
+fn a_real_slurm_cluster_runs_the_job_array() {
+    if std::env::var("SWIMLAB_SLURM").as_deref() != Ok("1") {
+        eprintln!("skipped: no SLURM cluster (SWIMLAB_SLURM=1 after .ci/slurm-up)");
+        return;
+    }
+    let d = dir("real-slurm");
+    std::fs::write(d.join("drift.rhai"), SCRIPT).unwrap();
+    let grid = ["--grid", "D=8,12", "--grid", "PHI=0.5,1.0,2.0"];
+    let mut local = vec!["sweep", "drift.rhai"];
+    local.extend(grid);
+    local.extend(["--out", "local"]);
+    assert!(swimlab(&local, &d).status.success());
+    let mut slurm = vec!["sweep", "drift.rhai"];
+    slurm.extend(grid);
+    slurm.extend(["--out", "cluster", "--slurm"]);
+    assert!(swimlab(&slurm, &d).status.success());
+    let mut job = Command::new("sbatch")
+        .args(["--wait", "cluster/sweep.sbatch"])
+        .current_dir(&d)
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(st) = job.try_wait().unwrap() {
+            break st;
+        }
+        if start.elapsed() > std::time::Duration::from_secs(300) {
+            let _ = job.kill();
+            panic!("the SLURM job array did not finish within 5 minutes");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    };
+    assert!(status.success(), "sbatch --wait: {status}");
+    for k in 0..6 {
+        for file in ["result.csv", "stdout.txt"] {
+            let a = std::fs::read(d.join("local").join(k.to_string()).join(file)).unwrap();
+            let b = std::fs::read(d.join("cluster").join(k.to_string()).join(file)).unwrap();
+            assert_eq!(
+                a, b,
+                "point {k}: {file} differs between the local sweep and SLURM"
+            );
+        }
+    }
+    let rows = index(&d.join("cluster"));
+    assert!(rows.iter().all(|r| r[3] == "ok"), "{rows:?}");
+}
