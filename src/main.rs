@@ -119,7 +119,8 @@ enum BenchKind {
     /// all cores, against the ~1e9 per core bound.
     Pairs,
     /// Cost per stroke period against the number of swimmers (2 … 4,096; --quick: up to 256),
-    /// microscopic and averaged models on the CPU, with fitted power-law exponents.
+    /// microscopic and averaged models on the CPU (the averaged with a cutoff up to 8x larger)
+    /// and on the GPU when an adapter is present, with fitted power-law exponents.
     Scaling,
 }
 

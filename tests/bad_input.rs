@@ -373,6 +373,15 @@ fn set_values_are_read_or_refused() {
     std::fs::write(&file, "print(`tag=${tag}`);\n").unwrap();
     let out = swimlab(&["run", f, "--set", "tag=7"], "", &d);
     check("read in a string", &out, "tag=7", 0);
+    // param as the last expression of a block (an if branch, a function body) is a statement in
+    // Rhai's tree: it counts as a read too (it was refused as "never reads").
+    std::fs::write(
+        &file,
+        "let p = if quick() { 1 } else { param(\"P\", 2) };\nfn f() { param(\"Q\", 3) }\nprint(`P=${p} Q=${f()}`);\n",
+    )
+    .unwrap();
+    let out = swimlab(&["run", f, "--set", "P=5", "--set", "Q=6"], "", &d);
+    check("param ending a block", &out, "P=5 Q=6", 0);
 }
 
 /// Thermal noise's bad input: each refused at the script position with the reason and the fix.

@@ -72,28 +72,28 @@ pub fn backends(rows: &[BackendRow]) -> Figure {
     )
 }
 
-/// Cost per period against the number of swimmers, both models, with the fitted power laws.
+/// Cost per period against the number of swimmers, every series, with the fitted power laws.
 pub fn scaling(rows: &[ScalingRow]) -> Figure {
     let mut series = Vec::new();
-    for (k, (model, cutoff)) in scaling::series().into_iter().enumerate() {
-        let mine: Vec<&ScalingRow> = rows
+    let gpu = rows
+        .iter()
+        .any(|r| r.line.backend == crate::engine::Backend::Gpu);
+    for (k, line) in scaling::series(gpu).iter().enumerate() {
+        let measured: Vec<(f64, f64)> = rows
             .iter()
-            .filter(|r| r.model == model && r.cutoff == cutoff)
-            .collect();
-        if mine.is_empty() {
-            continue;
-        }
-        let measured: Vec<(f64, f64)> = mine
-            .iter()
+            .filter(|r| r.line == *line)
             .map(|r| (r.swimmers as f64, r.per_period()))
             .collect();
+        if measured.is_empty() {
+            continue;
+        }
         series.push(Series::from_points(
-            scaling::label(model, cutoff),
+            scaling::label(line),
             &measured,
             Style::Points,
             Some(k),
         ));
-        if let Some((slope, c)) = scaling::fit(rows, model, cutoff, 256) {
+        if let Some((slope, c)) = scaling::fit(rows, line, 256) {
             let fitted: Vec<(f64, f64)> = measured
                 .iter()
                 .map(|&(x, _)| (x, c * x.powf(slope)))
@@ -103,11 +103,14 @@ pub fn scaling(rows: &[ScalingRow]) -> Figure {
         }
     }
     log_log(
-        "cost per stroke period on the CPU".into(),
+        format!(
+            "cost per stroke period{}",
+            if gpu { ", CPU and GPU" } else { " on the CPU" }
+        ),
         "swimmers S",
         "wall time per period [s]",
         series,
-        Legend::UpperLeft,
+        Legend::Outside,
     )
 }
 

@@ -92,17 +92,24 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
         Kind::Scaling => {
             let rows = scaling::run(if quick { 256 } else { 4096 })?;
             let t = scaling::table(&rows);
+            let gpu = rows
+                .iter()
+                .any(|r| r.line.backend == crate::engine::Backend::Gpu);
             println!(
-                "cost per stroke period on the CPU ({} threads; lattice scenes 3 ell apart, RK4: micro at its default step, averaged one step per period; the cutoff series up to 8x larger):\n{}",
+                "cost per stroke period ({} CPU threads{}; lattice scenes 3 ell apart, RK4: micro at its default step, averaged one step per period; the cutoff series up to 8x larger):\n{}",
                 rayon::current_num_threads(),
+                match crate::engine::gpu::device() {
+                    Ok(d) => format!("; gpu: {}", d.describe()),
+                    Err(_) => "; no GPU adapter: CPU series only".into(),
+                },
                 t.render()
             );
-            for (m, cutoff) in scaling::series() {
+            for line in scaling::series(gpu) {
                 for from in [2, 256] {
-                    if let Some((k, c)) = scaling::fit(&rows, m, cutoff, from) {
+                    if let Some((k, c)) = scaling::fit(&rows, &line, from) {
                         println!(
                             "{}: cost per period ~ {c:.2e} s * S^{k:.2} (fit over S >= {from})",
-                            scaling::label(m, cutoff)
+                            scaling::label(&line)
                         );
                     }
                 }

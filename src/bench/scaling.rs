@@ -1,6 +1,7 @@
 //! Cost per stroke period against the number of swimmers S, for the microscopic and the averaged
-//! model on the CPU, and the averaged model with a far-field cutoff of [`CUTOFF_ELLS`] ℓ (cell
-//! lists: O(S)), with the exponent of a power-law fit.
+//! model on the CPU, the averaged model with a far-field cutoff of [`CUTOFF_ELLS`] ℓ (cell
+//! lists: O(S)), and both models on the GPU when an adapter is present, with the exponent of a
+//! power-law fit.
 //!
 //! Each size is a cubic lattice of Fig-1 swimmers 3ℓ apart (every pair interacts,
 //! [`crate::engine::build::lattice_scene`]). The time per RK4 step is measured
@@ -16,13 +17,22 @@ use crate::engine::build::lattice_scene;
 use crate::engine::calibrate::step_time_with_cutoff;
 use crate::engine::{Backend, Model};
 
-/// One measured size.
-#[derive(Debug, Clone)]
-pub struct Row {
+/// One series: a model on a backend, with or without a cutoff.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Line {
     /// Model.
     pub model: Model,
     /// The averaged model's far-field cutoff (m), if any.
     pub cutoff: Option<f64>,
+    /// CPU or GPU.
+    pub backend: Backend,
+}
+
+/// One measured size.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// The series.
+    pub line: Line,
     /// Swimmers.
     pub swimmers: usize,
     /// Seconds per RK4 step.
@@ -41,29 +51,54 @@ impl Row {
 /// The cutoff of the third series, in ℓ (the lattice is 3ℓ apart: ~150 partners each).
 pub const CUTOFF_ELLS: f64 = 10.0;
 
-/// The series measured: (model, cutoff in m).
-pub fn series() -> [(Model, Option<f64>); 3] {
+/// The series measured: the three CPU series, and both models on the GPU when `gpu`.
+pub fn series(gpu: bool) -> Vec<Line> {
     let ell = crate::engine::Dumbbell::default().ell;
-    [
-        (Model::Micro, None),
-        (Model::Averaged, None),
-        (Model::Averaged, Some(CUTOFF_ELLS * ell)),
-    ]
-}
-
-/// A series' label: the model, and its cutoff.
-pub fn label(model: Model, cutoff: Option<f64>) -> String {
-    match cutoff {
-        Some(_) => format!("{}, cutoff {CUTOFF_ELLS} ell", model.name()),
-        None => model.name().to_string(),
+    let cpu = |model, cutoff| Line {
+        model,
+        cutoff,
+        backend: Backend::Cpu,
+    };
+    let mut v = vec![
+        cpu(Model::Micro, None),
+        cpu(Model::Averaged, None),
+        cpu(Model::Averaged, Some(CUTOFF_ELLS * ell)),
+    ];
+    if gpu {
+        for model in [Model::Micro, Model::Averaged] {
+            v.push(Line {
+                model,
+                cutoff: None,
+                backend: Backend::Gpu,
+            });
+        }
     }
+    v
 }
 
-/// Measure S = 2, 4, … `max` swimmers for both models, and up to 8 `max` for the averaged model
-/// with its cutoff.
+/// A series' label: the model, its cutoff, and "gpu" for the device.
+pub fn label(line: &Line) -> String {
+    let mut l = line.model.name().to_string();
+    if line.cutoff.is_some() {
+        l += &format!(", cutoff {CUTOFF_ELLS} ell");
+    }
+    if line.backend == Backend::Gpu {
+        l += ", gpu";
+    }
+    l
+}
+
+/// Measure S = 2, 4, … `max` swimmers for both models, up to 8 `max` for the averaged model with
+/// its cutoff, and both models on the GPU up to `max` when an adapter is present.
 pub fn run(max: usize) -> Result<Vec<Row>, String> {
+    let gpu = crate::engine::gpu::device().is_ok();
     let mut rows = Vec::new();
-    for (model, cutoff) in series() {
+    for line in series(gpu) {
+        let Line {
+            model,
+            cutoff,
+            backend,
+        } = line;
         let top = if cutoff.is_some() { 8 * max } else { max };
         let mut s = 2;
         while s <= top {
@@ -74,10 +109,9 @@ pub fn run(max: usize) -> Result<Vec<Row>, String> {
                 _ => (period / scene.default_micro_step()).ceil(),
             };
             let step =
-                step_time_with_cutoff(model, Backend::Cpu, s, cutoff).map_err(|e| e.to_string())?;
+                step_time_with_cutoff(model, backend, s, cutoff).map_err(|e| e.to_string())?;
             rows.push(Row {
-                model,
-                cutoff,
+                line,
                 swimmers: s,
                 step,
                 steps_per_period,
@@ -90,10 +124,10 @@ pub fn run(max: usize) -> Result<Vec<Row>, String> {
 
 /// Least-squares slope and prefactor of log(cost) against log(S) over the series' rows with
 /// S ≥ `from`: cost ≈ c · S^slope. `None` with fewer than two such rows.
-pub fn fit(rows: &[Row], model: Model, cutoff: Option<f64>, from: usize) -> Option<(f64, f64)> {
+pub fn fit(rows: &[Row], line: &Line, from: usize) -> Option<(f64, f64)> {
     let pts: Vec<(f64, f64)> = rows
         .iter()
-        .filter(|r| r.model == model && r.cutoff == cutoff && r.swimmers >= from)
+        .filter(|r| r.line == *line && r.swimmers >= from)
         .map(|r| ((r.swimmers as f64).ln(), r.per_period().ln()))
         .collect();
     if pts.len() < 2 {
@@ -121,7 +155,7 @@ pub fn table(rows: &[Row]) -> Table {
     ]);
     for r in rows {
         t.rows.push(vec![
-            label(r.model, r.cutoff),
+            label(&r.line),
             r.swimmers.to_string(),
             format!("{:.3e}", r.step),
             format!("{:.0}", r.steps_per_period),

@@ -77,15 +77,21 @@ struct Uses {
 pub fn check(ast: &AST, sets: &Sets) -> Result<(), (Position, String)> {
     use rhai::{ASTNode, Expr, Stmt};
     let names: Vec<&str> = sets.iter().map(|(n, _)| n.as_str()).collect();
+    let param_name = |f: &rhai::FnCallExpr| -> Option<String> {
+        if f.name != "param" || !f.namespace.is_empty() {
+            return None;
+        }
+        match f.args.first() {
+            Some(Expr::StringConstant(s, ..)) => Some(s.to_string()),
+            _ => None,
+        }
+    };
     let reads = |node: &ASTNode| -> Option<String> {
         match node {
             ASTNode::Expr(Expr::Variable(x, ..)) if x.2.is_empty() => Some(x.1.to_string()),
-            ASTNode::Expr(Expr::FnCall(f, ..)) if f.name == "param" && f.namespace.is_empty() => {
-                match f.args.first() {
-                    Some(Expr::StringConstant(s, ..)) => Some(s.to_string()),
-                    _ => None,
-                }
-            }
+            ASTNode::Expr(Expr::FnCall(f, ..)) => param_name(f),
+            // A call that ends a block (an if branch, a function body) is a statement.
+            ASTNode::Stmt(Stmt::FnCall(f, ..)) => param_name(f),
             _ => None,
         }
     };
