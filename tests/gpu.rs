@@ -307,3 +307,27 @@ fn without_an_adapter_auto_falls_back_and_gpu_refuses() {
         "{stderr}"
     );
 }
+
+/// `bench scaling` measures both models on the GPU beside the CPU series when an adapter is
+/// present: every series has a row per size, and the table names the GPU ones.
+#[test]
+fn bench_scaling_has_gpu_series() {
+    if !gpu_present("bench_scaling_has_gpu_series") {
+        return;
+    }
+    use swimlab::bench::scaling;
+    let rows = scaling::run(4).unwrap();
+    let lines = scaling::series(true);
+    assert_eq!(lines.len(), 5);
+    for line in &lines {
+        let n = rows.iter().filter(|r| r.line == *line).count();
+        let want = if line.cutoff.is_some() { 5 } else { 2 };
+        assert_eq!(n, want, "{}", scaling::label(line));
+    }
+    assert!(rows.iter().all(|r| r.step > 0.0 && r.step.is_finite()));
+    let table = scaling::table(&rows).render();
+    assert!(
+        table.contains("micro, gpu") && table.contains("averaged, gpu"),
+        "{table}"
+    );
+}
