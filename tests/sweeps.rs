@@ -135,21 +135,43 @@ fn resume_runs_only_the_points_not_finished() {
     assert!(index(&d.join("out")).iter().all(|r| r[2] == "ok"));
 }
 
-#[test]
-fn slurm_tasks_give_the_local_sweeps_files() {
-    let d = dir("slurm");
+/// The same 6-point grid swept locally into `local/` and written as a SLURM job into `cluster/`
+/// (not run); returns the job script.
+fn local_sweep_and_job(d: &Path) -> PathBuf {
     std::fs::write(d.join("drift.rhai"), SCRIPT).unwrap();
     let grid = ["--grid", "D=8,12", "--grid", "PHI=0.5,1.0,2.0"];
     let mut local = vec!["sweep", "drift.rhai"];
     local.extend(grid);
     local.extend(["--out", "local"]);
-    assert!(swimlab(&local, &d).status.success());
+    assert!(swimlab(&local, d).status.success());
     let mut slurm = vec!["sweep", "drift.rhai"];
     slurm.extend(grid);
     slurm.extend(["--out", "cluster", "--slurm"]);
-    let out = swimlab(&slurm, &d);
-    assert!(out.status.success());
-    let script = d.join("cluster/sweep.sbatch");
+    assert!(swimlab(&slurm, d).status.success());
+    d.join("cluster/sweep.sbatch")
+}
+
+/// Every point's result.csv and stdout.txt are the same in `local/` and `cluster/`, and
+/// cluster/index.csv says ok for all.
+fn cluster_equals_local(d: &Path) {
+    for k in 0..6 {
+        for file in ["result.csv", "stdout.txt"] {
+            let a = std::fs::read(d.join("local").join(k.to_string()).join(file)).unwrap();
+            let b = std::fs::read(d.join("cluster").join(k.to_string()).join(file)).unwrap();
+            assert_eq!(
+                a, b,
+                "point {k}: {file} differs between the local sweep and SLURM"
+            );
+        }
+    }
+    let rows = index(&d.join("cluster"));
+    assert!(rows.iter().all(|r| r[3] == "ok"), "{rows:?}");
+}
+
+#[test]
+fn slurm_tasks_give_the_local_sweeps_files() {
+    let d = dir("slurm");
+    let script = local_sweep_and_job(&d);
     let text = std::fs::read_to_string(&script).unwrap();
     assert!(text.starts_with("#!/bin/bash\n"));
     assert!(text.contains("#SBATCH --array=0-5\n"), "{text}");
@@ -168,18 +190,7 @@ fn slurm_tasks_give_the_local_sweeps_files() {
             String::from_utf8_lossy(&o.stderr)
         );
     }
-    for k in 0..6 {
-        for file in ["result.csv", "stdout.txt"] {
-            let a = std::fs::read(d.join("local").join(k.to_string()).join(file)).unwrap();
-            let b = std::fs::read(d.join("cluster").join(k.to_string()).join(file)).unwrap();
-            assert_eq!(
-                a, b,
-                "point {k}: {file} differs between the local sweep and the task"
-            );
-        }
-    }
-    let rows = index(&d.join("cluster"));
-    assert!(rows.iter().all(|r| r[3] == "ok"), "{rows:?}");
+    cluster_equals_local(&d);
     // Without a task id the script refuses, naming the variable.
     let o = Command::new("bash").arg(&script).output().unwrap();
     assert!(!o.status.success());
@@ -248,16 +259,7 @@ fn a_real_slurm_cluster_runs_the_job_array() {
         return;
     }
     let d = dir("real-slurm");
-    std::fs::write(d.join("drift.rhai"), SCRIPT).unwrap();
-    let grid = ["--grid", "D=8,12", "--grid", "PHI=0.5,1.0,2.0"];
-    let mut local = vec!["sweep", "drift.rhai"];
-    local.extend(grid);
-    local.extend(["--out", "local"]);
-    assert!(swimlab(&local, &d).status.success());
-    let mut slurm = vec!["sweep", "drift.rhai"];
-    slurm.extend(grid);
-    slurm.extend(["--out", "cluster", "--slurm"]);
-    assert!(swimlab(&slurm, &d).status.success());
+    local_sweep_and_job(&d);
     let mut job = Command::new("sbatch")
         .args(["--wait", "cluster/sweep.sbatch"])
         .current_dir(&d)
@@ -275,16 +277,5 @@ fn a_real_slurm_cluster_runs_the_job_array() {
         std::thread::sleep(std::time::Duration::from_millis(100));
     };
     assert!(status.success(), "sbatch --wait: {status}");
-    for k in 0..6 {
-        for file in ["result.csv", "stdout.txt"] {
-            let a = std::fs::read(d.join("local").join(k.to_string()).join(file)).unwrap();
-            let b = std::fs::read(d.join("cluster").join(k.to_string()).join(file)).unwrap();
-            assert_eq!(
-                a, b,
-                "point {k}: {file} differs between the local sweep and SLURM"
-            );
-        }
-    }
-    let rows = index(&d.join("cluster"));
-    assert!(rows.iter().all(|r| r[3] == "ok"), "{rows:?}");
+    cluster_equals_local(&d);
 }

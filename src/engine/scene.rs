@@ -351,11 +351,7 @@ impl Scene {
     /// which has no stroke inside a period, at 1/20 of the period. The rigid-stroke model keeps its
     /// default and refuses noise when it runs.
     fn default_noisy_integrator(&self) -> IntegratorSpec {
-        let t_min = self
-            .swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(f64::INFINITY, f64::min);
+        let t_min = self.shortest_period();
         let dt = match self.model {
             Model::Micro => (DEFAULT_NOISY_STEP_TIMES_RATE / self.stiff_rate())
                 .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min),
@@ -374,11 +370,7 @@ impl Scene {
     /// The microscopic model's default RK4 step for these swimmers (s): 0.8/rate of the stiffest
     /// spring, at most 1/200 of the shortest period.
     pub fn default_micro_step(&self) -> f64 {
-        let t_min = self
-            .swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(f64::INFINITY, f64::min);
+        let t_min = self.shortest_period();
         let dt = (DEFAULT_MICRO_STEP_TIMES_RATE / self.stiff_rate())
             .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min);
         if dt.is_finite() {
@@ -607,6 +599,14 @@ impl Scene {
             Model::Micro => (rh - d.w2() * v, rh + d.w1() * v),
             Model::Averaged | Model::Rigid => d.sphere_positions(rh, v, self.contact_length(d)),
         }
+    }
+
+    /// The shortest stroke period of the swimmers (s); infinite without swimmers.
+    pub fn shortest_period(&self) -> f64 {
+        self.swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// The largest spring relaxation rate k0 (1/γ1 + 1/γ2) in the scene (1/s): the stiffness.

@@ -326,11 +326,7 @@ impl Scene {
                 let dt = if f < 1.0 {
                     dt0 * f
                 } else {
-                    let t_min = self
-                        .swimmers
-                        .iter()
-                        .map(Dumbbell::period)
-                        .fold(f64::INFINITY, f64::min);
+                    let t_min = self.shortest_period();
                     (dt0 * f)
                         .min(2.0 / self.stiff_rate())
                         .min(t_min / 100.0)
@@ -343,11 +339,7 @@ impl Scene {
 
     /// RK4 steps per shortest period at the stability-bounded step 2.0/rate.
     fn stiff_steps_per_period(&self) -> f64 {
-        let t_min = self
-            .swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(f64::INFINITY, f64::min);
+        let t_min = self.shortest_period();
         t_min * self.stiff_rate() / 2.0
     }
 }
