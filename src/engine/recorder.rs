@@ -277,11 +277,6 @@ impl Recorder {
         }
     }
 
-    /// The trajectory this recorder writes, if any.
-    pub fn trajectory(&self) -> Option<&Trajectory> {
-        self.frames.as_ref()
-    }
-
     /// Stream rows to `path` as CSV from now on: the file is created with the header and every
     /// row taken so far, then each new row is appended (one whole line, unbuffered) as it is
     /// taken. A kill loses no row already recorded; a later `stream_csv` moves the stream.

@@ -36,7 +36,7 @@ pub struct Trajectory {
     path: PathBuf,
     /// The XYZ stream.
     stream: Option<LineStream>,
-    /// Times and file names (relative to the `.pvd`) of the frames written.
+    /// Times and file names (relative to the `.pvd`) of the `.vtp` frames written.
     frames: Vec<(f64, String)>,
 }
 
@@ -75,16 +75,6 @@ impl Trajectory {
         Ok(t)
     }
 
-    /// The format.
-    pub fn format(&self) -> Format {
-        self.format
-    }
-
-    /// Frames written so far.
-    pub fn frames(&self) -> usize {
-        self.frames.len()
-    }
-
     /// Where the `.vtp` frames of a `.pvd` go: `<name>_frames/` beside it.
     fn frame_dir(&self) -> PathBuf {
         let stem = self
@@ -103,7 +93,6 @@ impl Trajectory {
                 if let Some(s) = &mut self.stream {
                     s.append(text.trim_end_matches('\n'))?;
                 }
-                self.frames.push((scene.time(), String::new()));
             }
             Format::Pvd => {
                 let dir = self.frame_dir();
