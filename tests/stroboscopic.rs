@@ -42,8 +42,10 @@ impl OdeSystem for Forced {
     }
 }
 
-fn forced_error(m: u64) -> f64 {
-    let mut sys = Forced { eps: 2e-3, a: 0.5 };
+/// The end state of the forced system of rate `eps` after 800 periods of macro steps of `m`
+/// periods each, and the exact end state.
+fn forced_end(eps: f64, m: u64) -> (f64, f64) {
+    let mut sys = Forced { eps, a: 0.5 };
     let mut st = Stroboscopic::new(1e-6, 1.0, Box::new(Rk4::new(1.0 / 400.0)), 0, 0, 1.0)
         .with_fixed_macro_steps(m);
     let mut y = vec![1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
@@ -53,23 +55,33 @@ fn forced_error(m: u64) -> f64 {
         t = st.step(&mut sys, t, &mut y, t_end, &mut stats).unwrap();
     }
     assert_eq!(t, t_end);
-    let exact = sys.exact(1.0, t_end);
-    // Relative to the change over the run (the drift), as the method's tolerance is.
-    (y[0] - exact).abs() / (exact - 1.0).abs()
+    (y[0], sys.exact(1.0, t_end))
 }
 
 #[test]
-fn the_macro_method_is_third_order() {
-    // Macro steps of 25, 50, 100 periods (εH = 0.05 to 0.2): Bogacki-Shampine's third-order
-    // solution; the slope's own error, second order in the period (εT = 2e-3), lies ~1e-6
-    // below and does not reach these differences.
-    let e: Vec<f64> = [25, 50, 100].iter().map(|&m| forced_error(m)).collect();
-    // Measured orders 3.42 and 3.15, approaching 3 from above as εH falls (the next term of
-    // the error is still felt at εH = 0.1); a second- or fourth-order method gives ~2 or ~4.
-    let orders: Vec<f64> = (0..2).map(|k| (e[k + 1] / e[k]).log2()).collect();
+fn the_macro_method_is_fifth_order() {
+    // ε = 5e-3 a period, macro steps of 10 to 80 periods (εH = 0.05 to 0.4), compared with
+    // steps of 2 periods, whose macro error is 5⁵ = 3,125 times below the 10-period one's: both
+    // share the slope's own error, second order in the period, which is ~1e-6 of the change and
+    // would hide a fifth-order macro error below εH ≈ 0.2 against the exact solution.
+    let eps = 5e-3;
+    let (fine, exact) = forced_end(eps, 2);
+    let change = (exact - 1.0).abs();
+    assert!(
+        (fine - exact).abs() < 3e-6 * change,
+        "the slope's own error: {}",
+        (fine - exact).abs() / change
+    );
+    let e: Vec<f64> = [10, 20, 40, 80]
+        .iter()
+        .map(|&m| (forced_end(eps, m).0 - fine).abs() / change)
+        .collect();
+    let orders: Vec<f64> = (0..3).map(|k| (e[k + 1] / e[k]).log2()).collect();
+    // Measured 5.03, 5.23, 5.45: approaching 5 from above as εH falls (the next term is still
+    // felt at εH = 0.2); a fourth- or sixth-order method gives ~4 or ~6.
     eprintln!("errors {e:?}, observed orders {orders:?}");
     for p in orders {
-        assert!((2.7..3.6).contains(&p), "order {p}, errors {e:?}");
+        assert!((4.6..5.7).contains(&p), "order {p}, errors {e:?}");
     }
 }
 

@@ -4,7 +4,7 @@
 use super::system::{check_state, fit, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
 
 const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
-const A: [[f64; 6]; 7] = [
+pub(super) const A: [[f64; 6]; 7] = [
     [0.0; 6],
     [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
@@ -35,7 +35,7 @@ const A: [[f64; 6]; 7] = [
     ],
 ];
 /// Fifth-order solution minus embedded fourth-order one.
-const E: [f64; 7] = [
+pub(super) const E: [f64; 7] = [
     71.0 / 57600.0,
     0.0,
     -71.0 / 16695.0,
