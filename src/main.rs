@@ -80,6 +80,15 @@ enum Command {
         #[arg(long, value_name = "K")]
         task: Option<usize>,
     },
+    /// Run as a Jupyter kernel on a connection file (Jupyter starts it so), or install the
+    /// kernelspec: `swimlab kernel install [--user | --prefix DIR]`.
+    Kernel {
+        /// The connection file Jupyter wrote (ports, address, signing key).
+        #[arg(short = 'f', value_name = "CONNECTION_FILE")]
+        connection_file: Option<PathBuf>,
+        #[command(subcommand)]
+        action: Option<KernelAction>,
+    },
     /// Render every figure of the paper (scripts/paper, built in): CSV and PNG to out/paper/,
     /// and the PNGs also to --out if given (e.g. docs/figures for the README).
     MakeFigures {
@@ -89,6 +98,19 @@ enum Command {
         /// Also copy the pictures here.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum KernelAction {
+    /// Write the kernelspec "swimlab" (kernel.json) so that Jupyter lists this kernel.
+    Install {
+        /// Into the user's Jupyter data folder (the default).
+        #[arg(long, conflicts_with = "prefix")]
+        user: bool,
+        /// Into DIR/share/jupyter/kernels (an environment's prefix, e.g. a venv).
+        #[arg(long, value_name = "DIR")]
+        prefix: Option<PathBuf>,
     },
 }
 
@@ -170,6 +192,22 @@ fn main() -> ExitCode {
                         }
                     })
             }
+            Some(Command::Kernel {
+                connection_file,
+                action,
+            }) => match (action, connection_file) {
+                (Some(KernelAction::Install { prefix, .. }), _) => {
+                    let target = match prefix {
+                        Some(p) => swimlab::repl::kernel::spec::Target::Prefix(p),
+                        None => swimlab::repl::kernel::spec::Target::User,
+                    };
+                    swimlab::repl::kernel::spec::install(&target).map(|dir| {
+                        println!("installed the swimlab kernel in {}", dir.display())
+                    })
+                }
+                (None, Some(file)) => swimlab::repl::kernel::run(&file),
+                (None, None) => Err("swimlab kernel needs a connection file (-f FILE; Jupyter gives one), or `swimlab kernel install` to register the kernel with Jupyter".into()),
+            },
             Some(Command::MakeFigures { quick, out }) => {
                 swimlab::script::interrupt::install_batch_handler();
                 swimlab::script::figures::make_figures(quick, out.as_deref())

@@ -3,6 +3,7 @@
 //! sharing the recorders' triggers, and an XYZ stream that keeps every frame through `kill -9`.
 
 mod common;
+use common::python_with;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -50,31 +51,13 @@ fn run_with_trajectory(path: &Path) -> (Scene, Vec<f64>) {
     (sim.into_scene(), times)
 }
 
-/// A Python with ASE: `SWIMLAB_PYTHON`, else the `.venv` that `.ci/run` makes. Without one the
-/// ASE test is skipped with a message, unless `SWIMLAB_REQUIRE_ASE=1` (CI) makes that a failure.
+/// A Python with ASE (skipped without one, unless `SWIMLAB_REQUIRE_ASE=1`, as in CI).
 fn python_with_ase() -> Option<PathBuf> {
-    let candidates = [
-        std::env::var_os("SWIMLAB_PYTHON").map(PathBuf::from),
-        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python")),
-    ];
-    let found = candidates.into_iter().flatten().find(|p| {
-        Command::new(p)
-            .args(["-c", "import ase.io"])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success())
-    });
-    if found.is_none() {
-        assert!(
-            std::env::var("SWIMLAB_REQUIRE_ASE").as_deref() != Ok("1"),
-            "SWIMLAB_REQUIRE_ASE=1 but no Python with ASE (set SWIMLAB_PYTHON or run .ci/run)"
-        );
-        eprintln!(
-            "skipped: no Python with ASE (python3 -m venv .venv && .venv/bin/pip install ase)"
-        );
-    }
-    found
+    python_with(
+        "ase.io",
+        "SWIMLAB_REQUIRE_ASE",
+        "python3 -m venv .venv && .venv/bin/pip install ase",
+    )
 }
 
 #[test]

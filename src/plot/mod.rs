@@ -10,7 +10,20 @@ mod render;
 mod snapshot;
 mod text;
 
-pub use snapshot::{snapshot, Plane, SceneFilm, SnapshotOptions};
+pub use snapshot::{scene_image, snapshot, Plane, SceneFilm, SnapshotOptions};
+
+/// A picture drawn in memory (for notebooks): PNG bytes and SVG text of the same drawing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// The PNG file's bytes.
+    pub png: Vec<u8>,
+    /// The SVG document.
+    pub svg: String,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
 pub use text::render_text;
 
 /// How a series is drawn.
@@ -290,6 +303,12 @@ impl Figure {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
                 (a.min(*v), b.max(*v))
             })
+    }
+
+    /// Draw in memory, as PNG and SVG.
+    pub fn image(&self) -> Result<Image, String> {
+        self.validate()?;
+        render::in_memory((self.width, self.height), self)
     }
 
     /// Draw to `path` (SVG or PNG by its extension); folders are created.

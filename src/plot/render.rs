@@ -51,6 +51,72 @@ pub(super) fn figure(f: &Figure, path: &Path, format: Format) -> Result<(), Stri
     }
 }
 
+/// A picture drawn in memory by `draw` onto an SVG and a bitmap of `size`: the SVG text and the
+/// PNG bytes.
+pub(super) fn in_memory(size: (u32, u32), picture: &dyn Drawable) -> Result<super::Image, String> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        picture.draw_svg(&root)?;
+        root.present().map_err(err)?;
+    }
+    let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        picture.draw_bitmap(&root)?;
+        root.present().map_err(err)?;
+    }
+    Ok(super::Image {
+        png: encode_png(&rgb, size)?,
+        svg,
+        width: size.0,
+        height: size.1,
+    })
+}
+
+/// What [`in_memory`] draws: a figure or a scene picture, on either backend.
+pub(super) trait Drawable {
+    fn draw_svg(&self, root: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>;
+    fn draw_bitmap(&self, root: &DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>;
+}
+
+impl Drawable for Figure {
+    fn draw_svg(&self, root: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String> {
+        draw_figure(self, root)
+    }
+    fn draw_bitmap(&self, root: &DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String> {
+        draw_figure(self, root)
+    }
+}
+
+impl Drawable for ScenePicture<'_> {
+    fn draw_svg(&self, root: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String> {
+        draw_scene(self, root).map(|_| ())
+    }
+    fn draw_bitmap(&self, root: &DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String> {
+        draw_scene(self, root).map(|_| ())
+    }
+}
+
+/// RGB pixels as PNG bytes.
+fn encode_png(rgb: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc
+        .write_header()
+        .map_err(|e| format!("cannot encode the picture: {e}"))?;
+    writer
+        .write_image_data(rgb)
+        .map_err(|e| format!("cannot encode the picture: {e}"))?;
+    writer
+        .finish()
+        .map_err(|e| format!("cannot encode the picture: {e}"))?;
+    Ok(out)
+}
+
 /// A tick label with as many digits as the axis span needs ([`super::format_number`]).
 fn tick(v: f64, span: f64) -> String {
     super::format_number(v, span)

@@ -79,6 +79,12 @@ pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<()
     render::scene(&picture, path, format)
 }
 
+/// A picture of `scene` drawn in memory (PNG and SVG), as [`snapshot`] draws it to a file.
+pub fn scene_image(scene: &Scene, opts: &SnapshotOptions) -> Result<super::Image, String> {
+    let picture = picture(scene, opts)?;
+    render::in_memory(picture.size, &picture)
+}
+
 /// An animated GIF of a scene as it runs: a frame per [`SceneFilm::frame`], every frame showing
 /// the region of the first (so the picture holds still while the swimmers move).
 pub struct SceneFilm {

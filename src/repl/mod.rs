@@ -2,6 +2,7 @@
 //! terminal ([`terminal`]), so the logic is tested without one.
 
 mod helper;
+pub mod kernel;
 mod session;
 pub mod terminal;
 

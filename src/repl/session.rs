@@ -24,7 +24,15 @@ pub struct Session {
     scope: Scope<'static>,
     functions: AST,
     inputs: usize,
+    /// Completion's registered names, made on first use.
+    names: std::sync::OnceLock<Vec<String>>,
 }
+
+/// Keywords offered by completion.
+const KEYWORDS: &[&str] = &[
+    "let", "const", "fn", "if", "else", "for", "in", "while", "loop", "break", "continue",
+    "return", "true", "false", "print", "throw", "try", "catch", "import", "export",
+];
 
 impl Default for Session {
     fn default() -> Self {
@@ -56,6 +64,7 @@ impl Session {
             scope: Scope::new(),
             functions: AST::empty(),
             inputs: 0,
+            names: std::sync::OnceLock::new(),
         }
     }
 
@@ -82,23 +91,42 @@ impl Session {
         if let Some(cmd) = t.strip_prefix(':') {
             return self.command(cmd);
         }
-        self.inputs += 1;
-        let name = format!("<input {}>", self.inputs);
+        let name = self.next_name();
         self.eval(&name, input)
     }
 
+    /// Run one input of code (not a `:command`): its value, `None` when there is none to show
+    /// (unit, or a trailing `;`), or the rendered error.
+    pub fn execute(&mut self, input: &str) -> Result<Option<Dynamic>, String> {
+        let name = self.next_name();
+        self.value_of(&name, input)
+    }
+
+    fn next_name(&mut self) -> String {
+        self.inputs += 1;
+        format!("<input {}>", self.inputs)
+    }
+
     fn eval(&mut self, name: &str, source: &str) -> Reply {
+        match self.value_of(name, source) {
+            Ok(Some(v)) => Reply::Output(format!("=> {}", show(&v))),
+            Ok(None) => Reply::Output(String::new()),
+            Err(e) => Reply::Error(e),
+        }
+    }
+
+    fn value_of(&mut self, name: &str, source: &str) -> Result<Option<Dynamic>, String> {
         let source = script::strip_bom(source);
         // A panic (a bug) becomes an error reply; the session, its scope and scenes stay.
         let guarded = script::guard(name, || Ok(self.eval_unguarded(name, source)));
-        guarded.unwrap_or_else(Reply::Error)
+        guarded.unwrap_or_else(Err)
     }
 
-    fn eval_unguarded(&mut self, name: &str, source: &str) -> Reply {
+    fn eval_unguarded(&mut self, name: &str, source: &str) -> Result<Option<Dynamic>, String> {
         interrupt::clear();
         let ast = match self.engine.compile_with_scope(&self.scope, source) {
             Ok(a) => a,
-            Err(e) => return Reply::Error(render_error(name, source, &e.into())),
+            Err(e) => return Err(render_error(name, source, &e.into())),
         };
         let merged = self.functions.merge(&ast);
         let result = self
@@ -113,9 +141,9 @@ impl Session {
         // As in IPython and Julia, a trailing `;` means "don't show the value".
         let quiet = source.trim_end().ends_with(';');
         match result {
-            Ok(v) if v.is_unit() || quiet => Reply::Output(String::new()),
-            Ok(v) => Reply::Output(format!("=> {}", show(&v))),
-            Err(e) => Reply::Error(render_error(name, source, &e)),
+            Ok(v) if v.is_unit() || quiet => Ok(None),
+            Ok(v) => Ok(Some(v)),
+            Err(e) => Err(render_error(name, source, &e)),
         }
     }
 
@@ -127,11 +155,8 @@ impl Session {
         match word {
             "quit" | "q" | "exit" => Reply::Quit,
             "help" | "h" if arg.is_empty() => Reply::Output(help_overview()),
-            "help" | "h" => match docs::lookup(arg) {
-                Some(d) => Reply::Output(format!(
-                    "{}\n\n  {}\n\nexample:\n  {}",
-                    d.signature, d.about, d.example
-                )),
+            "help" | "h" => match Session::help(arg) {
+                Some(text) => Reply::Output(text),
                 None => Reply::Error(format!(
                     "no help for \"{arg}\"{}; :help lists every name",
                     script::suggest_name(arg)
@@ -215,9 +240,85 @@ impl Session {
             .collect()
     }
 
-    /// The engine (for the front end's validator and completer).
+    /// The engine (for the front end's validator).
     pub fn engine(&self) -> &Engine {
         &self.engine
+    }
+
+    /// Send what `print` prints to `sink` instead of standard output (a notebook's stream).
+    pub fn on_print(&mut self, sink: impl Fn(&str) + Send + Sync + 'static) {
+        self.engine.on_print(sink);
+    }
+
+    /// Completions of the word that ends at byte `pos` of `line`: where the word starts and the
+    /// candidates (registered and documented names, variables, functions, keywords; after a `.`
+    /// the registered names; at the start of a line the `:commands`).
+    pub fn complete(&self, line: &str, pos: usize) -> (usize, Vec<String>) {
+        let pos = pos.min(line.len());
+        let pos = (0..=pos)
+            .rev()
+            .find(|&p| line.is_char_boundary(p))
+            .unwrap_or(0);
+        let head = &line[..pos];
+        let start = head
+            .char_indices()
+            .rev()
+            .find(|(_, c)| !(c.is_alphanumeric() || *c == '_' || *c == ':'))
+            .map_or(0, |(i, c)| i + c.len_utf8());
+        let prefix = &head[start..];
+        let after_dot = head[..start].ends_with('.');
+        let command = start == 0 && prefix.starts_with(':');
+        let mut out: Vec<String> = if command {
+            COMMANDS
+                .iter()
+                .map(|(c, _)| c.split_whitespace().next().unwrap_or(c).to_string())
+                .collect()
+        } else if after_dot {
+            self.names().to_vec()
+        } else {
+            self.names()
+                .iter()
+                .cloned()
+                .chain(self.variables())
+                .chain(self.user_functions())
+                .chain(KEYWORDS.iter().map(|k| k.to_string()))
+                .collect()
+        };
+        out.retain(|n| n.starts_with(prefix));
+        out.sort();
+        out.dedup();
+        (start, out)
+    }
+
+    /// The registered and documented names, sorted (computed once).
+    fn names(&self) -> &[String] {
+        self.names.get_or_init(|| {
+            let mut names: Vec<String> = docs::DOCS.iter().map(|d| d.name.to_string()).collect();
+            for sig in self.engine.gen_fn_signatures(false) {
+                let name = sig.split('(').next().unwrap_or("");
+                let name = name.trim_start_matches("get$").trim_start_matches("set$");
+                if name
+                    .chars()
+                    .next()
+                    .is_some_and(|c| c.is_alphabetic() || c == '_')
+                {
+                    names.push(name.to_string());
+                }
+            }
+            names.sort();
+            names.dedup();
+            names
+        })
+    }
+
+    /// The help of `name` (what `:help NAME` shows), if it is documented.
+    pub fn help(name: &str) -> Option<String> {
+        docs::lookup(name).map(|d| {
+            format!(
+                "{}\n\n  {}\n\nexample:\n  {}",
+                d.signature, d.about, d.example
+            )
+        })
     }
 }
 

@@ -2,7 +2,8 @@
 
 use super::{
     csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, limits, observable_api,
-    panic_guard::guard, params, plot_api, render_error, scene_api, stdlib, sweep_api, util_api,
+    panic_guard::guard, params, picture_api, plot_api, render_error, scene_api, stdlib, sweep_api,
+    util_api,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -30,6 +31,7 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     util_api::register(&mut engine);
     sweep_api::register(&mut engine);
     plot_api::register(&mut engine);
+    picture_api::register(&mut engine);
     params::register_defaults(&mut engine);
     let embedded = stdlib::install(&mut engine);
     // Ctrl-C also stops plain script loops between statements.

@@ -14,8 +14,9 @@ pub mod limits;
 mod observable_api;
 mod panic_guard;
 pub mod params;
+mod picture_api;
 mod plot_api;
-mod progress;
+pub mod progress;
 mod render;
 mod scene_api;
 mod scene_settings_api;
@@ -39,6 +40,7 @@ pub use engine_builder::{
 };
 pub use observable_api::RecorderHandle;
 pub use panic_guard::guard;
+pub use picture_api::Picture;
 pub use render::render_error;
 pub use scene_api::SceneHandle;
 pub use show::show;

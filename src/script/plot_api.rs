@@ -8,9 +8,11 @@
 use super::convert::{lift, number, script_error, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
+use super::picture_api::Picture;
 use super::scene_api::SceneHandle;
 use crate::plot::{
-    render_text, snapshot, Figure, Legend, Plane, SceneFilm, Series, SnapshotOptions, Style,
+    render_text, scene_image, snapshot, Figure, Legend, Plane, SceneFilm, Series, SnapshotOptions,
+    Style,
 };
 use rhai::{Array, Dynamic, Engine, Map, INT};
 
@@ -306,8 +308,60 @@ fn animate(s: &mut SceneHandle, path: &str, opts: &Map) -> ScriptResult<INT> {
     Ok(film.frames() as INT)
 }
 
+/// `f` drawn in memory.
+fn picture(f: &Figure) -> ScriptResult<Picture> {
+    Ok(Picture::new(
+        f.image().map_err(|e| script_error(format!("plot: {e}")))?,
+        "plot",
+    ))
+}
+
+/// A picture of the scene in memory.
+fn scene_picture(s: &SceneHandle, opts: &SnapshotOptions) -> ScriptResult<Picture> {
+    let image =
+        scene_image(&s.borrow(), opts).map_err(|e| script_error(format!("snapshot: {e}")))?;
+    Ok(Picture::new(image, "snapshot"))
+}
+
 /// Register the picture functions.
 pub fn register(engine: &mut Engine) {
+    // Without a path: a Picture value (notebooks show it inline).
+    engine
+        .register_fn("plot", |series: Dynamic| -> ScriptResult<Picture> {
+            picture(&figure_of(&series, &Map::new())?.0)
+        })
+        .register_fn(
+            "plot",
+            |series: Array, opts: Map| -> ScriptResult<Picture> {
+                picture(&figure_of(&Dynamic::from(series), &opts)?.0)
+            },
+        )
+        .register_fn("plot", |series: Map, opts: Map| -> ScriptResult<Picture> {
+            picture(&figure_of(&Dynamic::from(series), &opts)?.0)
+        })
+        .register_fn(
+            "plot",
+            |r: &mut RecorderHandle, x: &str, ys: Dynamic| -> ScriptResult<Picture> {
+                picture(&recorder_figure(r, x, &ys)?)
+            },
+        )
+        .register_fn(
+            "plot",
+            |r: &mut RecorderHandle, x: &str, ys: Dynamic, opts: Map| -> ScriptResult<Picture> {
+                let mut f = recorder_figure(r, x, &ys)?;
+                apply_options(&mut f, &opts)?;
+                picture(&f)
+            },
+        )
+        .register_fn("snapshot", |s: &mut SceneHandle| -> ScriptResult<Picture> {
+            scene_picture(s, &SnapshotOptions::default())
+        })
+        .register_fn(
+            "snapshot",
+            |s: &mut SceneHandle, opts: Map| -> ScriptResult<Picture> {
+                scene_picture(s, &snapshot_options(&opts)?)
+            },
+        );
     engine
         .register_fn(
             "animate",
@@ -386,8 +440,8 @@ pub fn register(engine: &mut Engine) {
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[
-    doc_entry!("plot", "pictures", "plot(path, series)\nplot(path, series, #{ title, x_label, y_label, log_x, log_y, width, height })\nrec.plot(path, x_column, y_columns)\nrec.plot(path, x_column, y_columns, options)", "Draw series to an SVG or PNG file (by the extension; folders are created). A series is #{ x: [..], y: [..], label: \"..\", style: \"line\" | \"points\" }; give one map or an array of them. rec.plot draws recorded columns against one column, with their units as labels. Text uses an embedded font: no system fonts needed.", "plot(\"out/help/p.svg\", [#{ x: [1, 2, 3], y: [1, 4, 9], label: \"x^2\" }, #{ x: [1, 2, 3], y: [1, 8, 27], label: \"x^3\", style: \"points\" }], #{ title: \"powers\", x_label: \"x\", y_label: \"y\", log_y: true });"),
+    doc_entry!("plot", "pictures", "plot(path, series)\nplot(path, series, #{ title, x_label, y_label, log_x, log_y, width, height })\nrec.plot(path, x_column, y_columns)\nrec.plot(path, x_column, y_columns, options)", "Draw series to an SVG or PNG file (by the extension; folders are created). A series is #{ x: [..], y: [..], label: \"..\", style: \"line\" | \"points\" }; give one map or an array of them. rec.plot draws recorded columns against one column, with their units as labels. Text uses an embedded font: no system fonts needed. Without a path, plot(series[, options]) and rec.plot(x_column, y_columns[, options]) return a Picture (:help Picture), which a notebook shows inline.", "plot(\"out/help/p.svg\", [#{ x: [1, 2, 3], y: [1, 4, 9], label: \"x^2\" }, #{ x: [1, 2, 3], y: [1, 8, 27], label: \"x^3\", style: \"points\" }], #{ title: \"powers\", x_label: \"x\", y_label: \"y\", log_y: true });"),
     doc_entry!("tplot", "pictures", "tplot(series)\ntplot(series, options)\nrec.tplot(x_column, y_columns)\nrec.tplot(x_column, y_columns, options)", "A quick plot as text in the terminal: series and options as for plot, plus cols and rows (the plot area in characters, default 72 x 18).", "tplot(#{ x: [0, 1, 2, 3], y: [0, 1, 4, 9], label: \"x^2\" }, #{ cols: 40, rows: 8 });"),
     doc_entry!("animate", "pictures", "s.animate(path) -> int\ns.animate(path, #{ periods, frames, fps, plane, title, width, height }) -> int", "Run the scene for periods periods (default 1) and write an animated GIF of it: the picture of s.snapshot now and after each of frames equal slices of the run (default 24; at most 2000), fps frames a second (default 12), every frame showing the first frame's region. The run is a run like any other: the scene moves on and recorders fire; Ctrl-C stops it and the frames so far stay a valid GIF. Returns the number of frames.", "let s = scene(); s.add(dumbbell(#{ a1: 1.125e-6, a2: 0.5625e-6 })); print(s.animate(\"out/help/stroke.gif\", #{ periods: 1, frames: 8 }));"),
-    doc_entry!("snapshot", "pictures", "s.snapshot(path)\ns.snapshot(path, #{ plane: \"xy\" | \"xz\" | \"yz\", title, width, height })", "A picture of the scene (SVG or PNG): every swimmer's spheres at their radii and its rod, projected on a plane, coloured by the in-plane direction of N (aligned swimmers share a colour; out-of-plane ones fade to grey). Call it in a loop for the frames of an animation.", "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [12e-6, 3e-6, 0], dir: [0, 1, 0] })); s.snapshot(\"out/help/scene.png\", #{ title: \"two swimmers\" });"),
+    doc_entry!("snapshot", "pictures", "s.snapshot(path)\ns.snapshot(path, #{ plane: \"xy\" | \"xz\" | \"yz\", title, width, height })", "A picture of the scene (SVG or PNG): every swimmer's spheres at their radii and its rod, projected on a plane, coloured by the in-plane direction of N (aligned swimmers share a colour; out-of-plane ones fade to grey). Call it in a loop for the frames of an animation. Without a path, s.snapshot() and s.snapshot(options) return a Picture (:help Picture).", "let s = scene(); s.add(dumbbell()); s.add(dumbbell(#{ center: [12e-6, 3e-6, 0], dir: [0, 1, 0] })); s.snapshot(\"out/help/scene.png\", #{ title: \"two swimmers\" });"),
 ];

@@ -3,6 +3,7 @@
 
 use super::dumbbell_api::DumbbellSpec;
 use super::observable_api::RecorderHandle;
+use super::picture_api::Picture;
 use super::scene_api::SceneHandle;
 use crate::engine::{IntegratorSpec, Observable, Trigger};
 use rhai::{Array, Dynamic, Map};
@@ -19,7 +20,7 @@ macro_rules! displayed {
 
 /// Text for a value printed by the REPL.
 pub fn show(v: &Dynamic) -> String {
-    displayed!(v; SceneHandle, DumbbellSpec, IntegratorSpec, Observable, Trigger, RecorderHandle);
+    displayed!(v; SceneHandle, DumbbellSpec, IntegratorSpec, Observable, Trigger, RecorderHandle, Picture);
     if let Some(a) = v.clone().try_cast::<Array>() {
         return format!("[{}]", a.iter().map(show).collect::<Vec<_>>().join(", "));
     }

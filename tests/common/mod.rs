@@ -73,3 +73,32 @@ pub fn reference() -> IntegratorSpec {
 pub fn rel(a: f64, b: f64) -> f64 {
     ((a - b) / b).abs()
 }
+
+/// A Python that imports `modules` (e.g. "ase.io"): `SWIMLAB_PYTHON`, else the `.venv` that
+/// `.ci/run` makes. Without one the caller's test is skipped with a message saying how to get
+/// one (`install`), unless the environment variable `require` is "1" (CI), which makes it a
+/// failure.
+pub fn python_with(modules: &str, require: &str, install: &str) -> Option<std::path::PathBuf> {
+    use std::path::{Path, PathBuf};
+    use std::process::{Command, Stdio};
+    let candidates = [
+        std::env::var_os("SWIMLAB_PYTHON").map(PathBuf::from),
+        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python")),
+    ];
+    let found = candidates.into_iter().flatten().find(|p| {
+        Command::new(p)
+            .args(["-c", &format!("import {modules}")])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var(require).as_deref() != Ok("1"),
+            "{require}=1 but no Python with {modules} (set SWIMLAB_PYTHON or run .ci/run)"
+        );
+        eprintln!("skipped: no Python with {modules} ({install})");
+    }
+    found
+}
