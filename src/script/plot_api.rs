@@ -152,7 +152,7 @@ fn save(f: &Figure, path: &str) -> ScriptResult<()> {
 
 fn show(f: &Figure, size: TextSize) -> ScriptResult<()> {
     let t = render_text(f, size.0, size.1).map_err(|e| script_error(format!("tplot: {e}")))?;
-    print!("{t}");
+    super::console::write(&t);
     Ok(())
 }
 

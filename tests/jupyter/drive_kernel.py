@@ -92,6 +92,9 @@ try:
     shown = of_type(out, "display_data")
     check("a picture is display_data, PNG and SVG",
           shown and shown[0]["data"]["image/png"].startswith("iVBORw0KGgo") and "<svg" in shown[0]["data"]["image/svg+xml"], [m["msg_type"] for m in out])
+    reply, out = run(kc, "tplot(#{ x: [0, 1, 2], y: [0, 1, 4] }, #{ cols: 30, rows: 6 })")
+    text = "".join(c["text"] for c in of_type(out, "stream"))
+    check("a text plot goes to the stdout stream", reply["status"] == "ok" and text.count("\n") >= 6, (reply, text))
     reply, out = run(kc, "s.snapshot()")
     check("a snapshot is shown", of_type(out, "display_data"), [m["msg_type"] for m in out])
 

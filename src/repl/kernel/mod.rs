@@ -13,7 +13,7 @@ pub mod spec;
 mod wire;
 
 use super::session::{Reply, Session};
-use crate::script::{interrupt, progress, show, Picture};
+use crate::script::{console, interrupt, progress, show, Picture};
 use base64::Engine as _;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -173,6 +173,11 @@ pub fn run(path: &Path) -> Result<(), String> {
             json!({"name": "stdout", "text": format!("{s}\n")}),
         );
     });
+    // Text that functions write themselves (tplot) goes to the same stream.
+    let sh = shared.clone();
+    console::set_sink(Some(Arc::new(move |s: &str| {
+        sh.publish_current("stream", json!({"name": "stdout", "text": s}));
+    })));
     let sh = shared.clone();
     let displays = Arc::new(AtomicU64::new(0));
     let progress_sink: progress::ProgressSink = Arc::new(move |line: Option<&str>| {
@@ -226,6 +231,7 @@ pub fn run(path: &Path) -> Result<(), String> {
         shared.publish(Some(&msg), "status", json!({"execution_state": "idle"}));
     }
     progress::set_sink(None);
+    console::set_sink(None);
     let _ = publisher.join();
     Ok(())
 }

@@ -1,0 +1,31 @@
+//! Text that script functions write themselves (a text plot), to standard output or to a front
+//! end's own sink (a notebook's stdout stream). Rhai's `print` goes through the session's
+//! `on_print`, which a notebook points at the same stream.
+
+use std::io::Write;
+use std::sync::{Arc, Mutex};
+
+/// Where written text goes instead of standard output.
+pub type TextSink = Arc<dyn Fn(&str) + Send + Sync>;
+
+static SINK: Mutex<Option<TextSink>> = Mutex::new(None);
+
+/// Send written text to `sink` (or standard output again, given `None`).
+pub fn set_sink(sink: Option<TextSink>) {
+    if let Ok(mut s) = SINK.lock() {
+        *s = sink;
+    }
+}
+
+/// Write `text` as it is (no newline added).
+pub fn write(text: &str) {
+    let sink = SINK.lock().ok().and_then(|s| s.clone());
+    match sink {
+        Some(f) => f(text),
+        None => {
+            let mut out = std::io::stdout().lock();
+            let _ = out.write_all(text.as_bytes());
+            let _ = out.flush();
+        }
+    }
+}
