@@ -95,6 +95,9 @@ try:
     reply, out = run(kc, "tplot(#{ x: [0, 1, 2], y: [0, 1, 4] }, #{ cols: 30, rows: 6 })")
     text = "".join(c["text"] for c in of_type(out, "stream"))
     check("a text plot goes to the stdout stream", reply["status"] == "ok" and text.count("\n") >= 6, (reply, text))
+    reply, out = run(kc, "for k in 0..2 { display(s.snapshot()); } display(1.5); 7")
+    shown = of_type(out, "display_data")
+    check("display(value) shows pictures and values mid-cell", len(shown) == 3 and "image/png" in shown[1]["data"] and shown[2]["data"]["text/plain"] == "1.5" and of_type(out, "execute_result"), [m["msg_type"] for m in out])
     reply, out = run(kc, "s.snapshot()")
     check("a snapshot is shown", of_type(out, "display_data"), [m["msg_type"] for m in out])
 

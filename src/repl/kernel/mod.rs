@@ -173,6 +173,12 @@ pub fn run(path: &Path) -> Result<(), String> {
             json!({"name": "stdout", "text": format!("{s}\n")}),
         );
     });
+    // display(value) mid-cell: a display_data now, pictures inline.
+    let sh = shared.clone();
+    console::set_display_sink(Some(Arc::new(move |v: &rhai::Dynamic| {
+        let (data, _) = mime_bundle(v);
+        sh.publish_current("display_data", json!({"data": data, "metadata": {}}));
+    })));
     // Text that functions write themselves (tplot) goes to the same stream.
     let sh = shared.clone();
     console::set_sink(Some(Arc::new(move |s: &str| {
@@ -232,6 +238,7 @@ pub fn run(path: &Path) -> Result<(), String> {
     }
     progress::set_sink(None);
     console::set_sink(None);
+    console::set_display_sink(None);
     let _ = publisher.join();
     Ok(())
 }
