@@ -128,7 +128,7 @@ try:
         check(f"the session continues after the interrupt ({how})", reply["status"] == "ok" and of_type(out, "execute_result")[0]["data"]["text/plain"] == "1", reply)
 
     # A long run shows an updating progress line.
-    reply, out = run(kc, "s.integrator = rk4(2e-7); s.run_periods(40.0)")
+    reply, out = run(kc, "s.integrator = rk4(2e-7); s.run_periods(100.0)")
     kinds = [m["msg_type"] for m in out]
     check("a long run shows progress updating in place", "display_data" in kinds and "update_display_data" in kinds, kinds)
 
