@@ -107,9 +107,12 @@ try:
           reply["status"] == "error" and err and any(line.strip() == "^" or line.rstrip().endswith("^") for line in err[0]["traceback"]) and ":2:" in err[0]["evalue"], (reply, err))
 
     # Interrupts: a long run stopped at a step boundary, the scene kept, the kernel alive.
+    # Rows every 0.02 periods: a few hundred in the 3 s before the interrupt.
+    run(kc, "let rec = s.record([R_H(0)], every_periods(0.02));")
     for how in ["message", "signal"]:
         t0 = run(kc, "s.time")[1]
         before = of_type(t0, "execute_result")[0]["data"]["text/plain"]
+        rows_before = int(of_type(run(kc, "rec.rows.len()")[1], "execute_result")[0]["data"]["text/plain"])
         msg_id = kc.execute("s.integrator = rk4(1e-7); s.run_periods(1e4)")
         time.sleep(3.0)
         if how == "message":
@@ -124,6 +127,8 @@ try:
         reply, out = run(kc, "s.time")
         after = of_type(out, "execute_result")[0]["data"]["text/plain"]
         check(f"the scene is kept and moved on ({how})", float(after) > float(before), (before, after))
+        rows_after = int(of_type(run(kc, "rec.rows.len()")[1], "execute_result")[0]["data"]["text/plain"])
+        check(f"the rows recorded before the interrupt are kept ({how})", rows_after > rows_before, (rows_before, rows_after))
         reply, out = run(kc, "s.integrator = \"default\"; s.run_periods(1.0); s.count")
         check(f"the session continues after the interrupt ({how})", reply["status"] == "ok" and of_type(out, "execute_result")[0]["data"]["text/plain"] == "1", reply)
 
