@@ -181,3 +181,37 @@ fn overlapping_form_is_continuous_with_mazur_at_contact_and_with_drag_inside() {
     let drag = 1.0 / (6.0 * PI * MU * 1e-6);
     assert!((h[(0, 0)] - drag).abs() < 1e-8 * drag && (h[(1, 1)] - drag).abs() < 1e-8 * drag);
 }
+
+/// `Scene::sphere_velocities` against the RPY formula written out for one dumbbell along x
+/// (unequal radii, spheres apart): a force on the a1 sphere moves it by Stokes drag and the a2
+/// sphere by (1/(4πμd))(1 − (a1² + a2²)/(3d²)) along the line, and (1/(8πμd))(1 + (a1² +
+/// a2²)/(3d²)) across it; a wrong count or a non-finite force is refused.
+#[test]
+fn sphere_velocities_follow_the_rpy_formula() {
+    use swimlab::engine::{Dumbbell, Scene};
+    let mut s = Scene::default();
+    let d = Dumbbell {
+        a1: 1.125e-6,
+        a2: 0.5625e-6,
+        ..Dumbbell::default()
+    };
+    s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
+    let (x1, x2) = s.spheres(0);
+    let r = (x2 - x1).norm();
+    let sum = d.a1 * d.a1 + d.a2 * d.a2;
+    let f = 1e-12;
+    let v = s
+        .sphere_velocities(&[Vector3::new(f, f, 0.0), Vector3::zeros()])
+        .unwrap();
+    let along = f / (4.0 * PI * MU * r) * (1.0 - sum / (3.0 * r * r));
+    let across = f / (8.0 * PI * MU * r) * (1.0 + sum / (3.0 * r * r));
+    let drag = f / (6.0 * PI * MU * d.a1);
+    // Each is a handful of flops from the same inputs: round-off only.
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * b.abs();
+    assert!(close(v[0].x, drag) && close(v[0].y, drag), "{:?}", v[0]);
+    assert!(close(v[1].x, along) && close(v[1].y, across), "{:?}", v[1]);
+    assert_eq!(v[1].z, 0.0);
+    assert!(s.sphere_velocities(&[Vector3::zeros()]).is_err());
+    let bad = s.sphere_velocities(&[Vector3::new(f64::NAN, 0.0, 0.0), Vector3::zeros()]);
+    assert!(bad.unwrap_err().to_string().contains("not finite"));
+}

@@ -590,6 +590,40 @@ impl Scene {
         })
     }
 
+    /// Sphere velocities (m/s) for given sphere forces (N), one per sphere, swimmer by swimmer
+    /// (the a1 sphere first), with the scene's mobility and viscosity at the present sphere
+    /// positions: v_α = F_α/(6πμa_α) + Σ_{β≠α} H_αβ F_β. For checks against other codes.
+    pub fn sphere_velocities(&self, forces: &[Vector3<f64>]) -> Result<Vec<Vector3<f64>>> {
+        let n = 2 * self.count();
+        if forces.len() != n {
+            return Err(invalid!(
+                "sphere velocities need one force per sphere: {n} for {} swimmers (two spheres each, the a1 sphere first), got {}",
+                self.count(),
+                forces.len()
+            ));
+        }
+        if let Some(k) = forces.iter().position(|f| !f.iter().all(|x| x.is_finite())) {
+            return Err(invalid!(
+                "the force on sphere {k} is not finite ({:?}); give finite numbers",
+                forces[k].as_slice()
+            ));
+        }
+        let mut pos = Vec::with_capacity(n);
+        let mut radii = Vec::with_capacity(n);
+        for (i, d) in self.swimmers.iter().enumerate() {
+            let (x1, x2) = self.spheres(i);
+            pos.extend([x1, x2]);
+            radii.extend([d.a1, d.a2]);
+        }
+        let mut v = vec![Vector3::zeros(); n];
+        self.mobility
+            .interaction_velocities(self.mu, &pos, &radii, forces, &mut v);
+        for ((vi, f), a) in v.iter_mut().zip(forces).zip(&radii) {
+            *vi += f * super::mobility::self_mobility(self.mu, *a);
+        }
+        Ok(v)
+    }
+
     /// Sphere centres (X₁, X₂) of swimmer `i` (m); in the averaged model at rest length L(t).
     pub fn spheres(&self, i: usize) -> (Vector3<f64>, Vector3<f64>) {
         let d = &self.swimmers[i];
