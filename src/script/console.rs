@@ -6,34 +6,57 @@
 use std::io::Write;
 use std::sync::{Arc, Mutex};
 
+/// A process-wide slot for a front end's callback (text, displays, progress), empty by default.
+pub struct Hook<T>(Mutex<Option<T>>);
+
+impl<T: Clone> Hook<T> {
+    /// An empty slot.
+    pub const fn new() -> Self {
+        Hook(Mutex::new(None))
+    }
+
+    /// Put `f` in the slot (or empty it, given `None`).
+    pub fn set(&self, f: Option<T>) {
+        if let Ok(mut s) = self.0.lock() {
+            *s = f;
+        }
+    }
+
+    /// The callback in the slot, if any.
+    pub fn get(&self) -> Option<T> {
+        self.0.lock().ok().and_then(|s| s.clone())
+    }
+}
+
+impl<T: Clone> Default for Hook<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// Where written text goes instead of standard output.
 pub type TextSink = Arc<dyn Fn(&str) + Send + Sync>;
 
-static SINK: Mutex<Option<TextSink>> = Mutex::new(None);
+static SINK: Hook<TextSink> = Hook::new();
 
 /// Send written text to `sink` (or standard output again, given `None`).
 pub fn set_sink(sink: Option<TextSink>) {
-    if let Ok(mut s) = SINK.lock() {
-        *s = sink;
-    }
+    SINK.set(sink);
 }
 
 /// Where `display(value)` shows values instead of writing their text.
 pub type DisplaySink = Arc<dyn Fn(&rhai::Dynamic) + Send + Sync>;
 
-static DISPLAY: Mutex<Option<DisplaySink>> = Mutex::new(None);
+static DISPLAY: Hook<DisplaySink> = Hook::new();
 
 /// Show `display(value)` values through `sink` (or as text again, given `None`).
 pub fn set_display_sink(sink: Option<DisplaySink>) {
-    if let Ok(mut s) = DISPLAY.lock() {
-        *s = sink;
-    }
+    DISPLAY.set(sink);
 }
 
 /// Show `v` now: through the display sink, else as the shell shows values.
 pub fn display(v: &rhai::Dynamic) {
-    let sink = DISPLAY.lock().ok().and_then(|s| s.clone());
-    match sink {
+    match DISPLAY.get() {
         Some(f) => f(v),
         None => write(&format!("{}\n", super::show(v))),
     }
@@ -41,8 +64,7 @@ pub fn display(v: &rhai::Dynamic) {
 
 /// Write `text` as it is (no newline added).
 pub fn write(text: &str) {
-    let sink = SINK.lock().ok().and_then(|s| s.clone());
-    match sink {
+    match SINK.get() {
         Some(f) => f(text),
         None => {
             let mut out = std::io::stdout().lock();

@@ -19,17 +19,11 @@ const SINK_INTERVAL: Duration = Duration::from_millis(250);
 /// A front end's own progress display: `Some(line)` while a run goes on, `None` when it ended.
 pub type ProgressSink = Arc<dyn Fn(Option<&str>) + Send + Sync>;
 
-static SINK: Mutex<Option<ProgressSink>> = Mutex::new(None);
+static SINK: super::console::Hook<ProgressSink> = super::console::Hook::new();
 
 /// Show the progress of long runs through `sink` (or the terminal bar again, given `None`).
 pub fn set_sink(sink: Option<ProgressSink>) {
-    if let Ok(mut s) = SINK.lock() {
-        *s = sink;
-    }
-}
-
-fn sink() -> Option<ProgressSink> {
-    SINK.lock().ok().and_then(|s| s.clone())
+    SINK.set(sink);
 }
 
 /// Whether bars may be drawn here.
@@ -77,7 +71,7 @@ impl RunBar {
         let total = (t_end - t0) * scale;
         let started = Instant::now();
         let wanted = std::env::var("SWIMLAB_PROGRESS").map_or(true, |v| v != "0");
-        if let Some(sink) = sink().filter(|_| wanted) {
+        if let Some(sink) = SINK.get().filter(|_| wanted) {
             let last: Arc<Mutex<Option<Instant>>> = Arc::new(Mutex::new(None));
             let (to, shared) = (sink.clone(), last.clone());
             let report: Progress = Arc::new(move |t: f64| {

@@ -226,28 +226,33 @@ impl Stroboscopic {
     ) -> Option<(Vec<f64>, Vec<f64>, f64)> {
         let h = m as f64 * self.period;
         let n = y.len();
+        // y + h Σ a_j k_j over the slopes so far.
+        let stage = |a: &[f64], ks: &[Vec<f64>]| -> Vec<f64> {
+            (0..n)
+                .map(|i| y[i] + h * a.iter().zip(ks).map(|(aj, k)| aj * k[i]).sum::<f64>())
+                .collect()
+        };
         let mut ks: Vec<Vec<f64>> = vec![k1.to_vec()];
-        let mut y_new = Vec::new();
-        for row in 1..7 {
-            let a = &A[row][..row];
-            let mut z: Vec<f64> = (0..n)
-                .map(|i| y[i] + h * a.iter().zip(&ks).map(|(aj, k)| aj * k[i]).sum::<f64>())
-                .collect();
-            if row == 6 {
-                // The last row is the solution (first same as last): its slope starts the next step.
-                sys.project(&mut z);
-                check_state(sys, t + h, &z).ok()?;
-                y_new = z.clone();
-            }
-            let k = self.slope_at(sys, t, &z, stats).ok()?;
-            ks.push(k);
+        for row in 1..6 {
+            let z = stage(&A[row][..row], &ks);
+            ks.push(self.slope_at(sys, t, &z, stats).ok()?);
         }
+        // The last row is the solution (first same as last): its slope starts the next step.
+        let mut y_new = stage(&A[6][..6], &ks);
+        sys.project(&mut y_new);
+        check_state(sys, t + h, &y_new).ok()?;
+        let k_new = self.slope_at(sys, t, &y_new, stats).ok()?;
         let err: Vec<f64> = (0..n)
-            .map(|i| h * E.iter().zip(&ks).map(|(ej, k)| ej * k[i]).sum::<f64>())
+            .map(|i| {
+                h * E
+                    .iter()
+                    .zip(ks.iter().chain([&k_new]))
+                    .map(|(ej, k)| ej * k[i])
+                    .sum::<f64>()
+            })
             .collect();
         let e = self.error_norm(y, &y_new, &err, m);
-        let last = ks.pop().expect("a tableau has stages");
-        Some((y_new, last, e))
+        Some((y_new, k_new, e))
     }
 
     fn leave(&mut self, t: f64, y: &[f64]) -> f64 {

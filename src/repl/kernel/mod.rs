@@ -17,7 +17,7 @@ use crate::script::{console, interrupt, progress, show, Picture};
 use base64::Engine as _;
 use serde_json::{json, Value};
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -113,6 +113,42 @@ impl Shared {
         self.publish(parent.as_ref(), msg_type, content);
     }
 
+    /// The next message on `socket` (blocking up to `timeout_ms`, -1 for ever), verified; a
+    /// message that fails verification is dropped with a note on stderr. `Err` when the socket
+    /// is closed.
+    fn receive(
+        &self,
+        socket: &zmq::Socket,
+        channel: &str,
+        timeout_ms: i64,
+    ) -> Result<Option<Message>, zmq::Error> {
+        if socket.poll(zmq::POLLIN, timeout_ms)? == 0 {
+            return Ok(None);
+        }
+        let frames = socket.recv_multipart(0)?;
+        Ok(match Message::decode(frames, &self.key) {
+            Ok(m) => Some(m),
+            Err(why) => {
+                eprintln!("swimlab kernel: dropped a message on the {channel} channel: {why}");
+                None
+            }
+        })
+    }
+
+    /// Answer a shutdown request (on the shell or control channel): stop a running cell at its
+    /// next step boundary and end the main loop after it.
+    fn shut_down(&self, socket: &zmq::Socket, msg: &Message) {
+        let restart = msg.content["restart"].as_bool().unwrap_or(false);
+        interrupt::request();
+        self.shutdown.store(true, Ordering::SeqCst);
+        self.reply(
+            socket,
+            msg,
+            "shutdown_reply",
+            json!({"status": "ok", "restart": restart}),
+        );
+    }
+
     fn reply(&self, socket: &zmq::Socket, parent: &Message, msg_type: &str, content: Value) {
         let m = self.headers.make(Some(parent), msg_type, content);
         let _ = socket.send_multipart(m.encode(&self.key), 0);
@@ -185,49 +221,34 @@ pub fn run(path: &Path) -> Result<(), String> {
         sh.publish_current("stream", json!({"name": "stdout", "text": s}));
     })));
     let sh = shared.clone();
-    let displays = Arc::new(AtomicU64::new(0));
+    // One display per run: shown at its first line, updated in place, cleared at its end.
+    let open: Mutex<Option<String>> = Mutex::new(None);
     let progress_sink: progress::ProgressSink = Arc::new(move |line: Option<&str>| {
-        // One display per run: shown at its first line, updated in place, cleared at its end.
-        let first = displays.load(Ordering::SeqCst) % 2 == 0;
-        let id = format!("swimlab-progress-{}", displays.load(Ordering::SeqCst) / 2);
-        let text = line.unwrap_or("");
-        let content = json!({
-            "data": {"text/plain": text},
-            "metadata": {},
-            "transient": {"display_id": id},
-        });
-        match (line, first) {
-            (Some(_), true) => {
-                displays.fetch_add(1, Ordering::SeqCst);
-                sh.publish_current("display_data", content);
-            }
-            (Some(_), false) => sh.publish_current("update_display_data", content),
-            (None, _) => {
-                if !first {
-                    displays.fetch_add(1, Ordering::SeqCst);
-                }
-                sh.publish_current("update_display_data", content);
-            }
-        }
+        let Ok(mut open) = open.lock() else { return };
+        let (msg_type, id) = match (line, open.as_ref()) {
+            (Some(_), None) => ("display_data", open.insert(wire::uuid()).clone()),
+            (Some(_), Some(id)) => ("update_display_data", id.clone()),
+            (None, _) => match open.take() {
+                Some(id) => ("update_display_data", id),
+                None => return,
+            },
+        };
+        sh.publish_current(
+            msg_type,
+            json!({
+                "data": {"text/plain": line.unwrap_or("")},
+                "metadata": {},
+                "transient": {"display_id": id},
+            }),
+        );
     });
     progress::set_sink(Some(progress_sink));
 
     let mut count = 0u64;
     shared.publish(None, "status", json!({"execution_state": "starting"}));
     while !shared.shutdown.load(Ordering::SeqCst) {
-        match shell.poll(zmq::POLLIN, 100) {
-            Ok(n) if n > 0 => {}
-            _ => continue,
-        }
-        let Ok(frames) = shell.recv_multipart(0) else {
+        let Ok(Some(msg)) = shared.receive(&shell, "shell", 100) else {
             continue;
-        };
-        let msg = match Message::decode(frames, &shared.key) {
-            Ok(m) => m,
-            Err(why) => {
-                eprintln!("swimlab kernel: dropped a message on the shell channel: {why}");
-                continue;
-            }
         };
         if let Ok(mut c) = shared.current.lock() {
             *c = Some(msg.clone());
@@ -264,15 +285,10 @@ fn kernel_info() -> Value {
 
 fn control_loop(control: &zmq::Socket, shared: &Shared) {
     loop {
-        let Ok(frames) = control.recv_multipart(0) else {
-            return;
-        };
-        let msg = match Message::decode(frames, &shared.key) {
-            Ok(m) => m,
-            Err(why) => {
-                eprintln!("swimlab kernel: dropped a message on the control channel: {why}");
-                continue;
-            }
+        let msg = match shared.receive(control, "control", -1) {
+            Ok(Some(m)) => m,
+            Ok(None) => continue,
+            Err(_) => return,
         };
         match msg.msg_type() {
             "interrupt_request" => {
@@ -280,15 +296,7 @@ fn control_loop(control: &zmq::Socket, shared: &Shared) {
                 shared.reply(control, &msg, "interrupt_reply", json!({"status": "ok"}));
             }
             "shutdown_request" => {
-                let restart = msg.content["restart"].as_bool().unwrap_or(false);
-                interrupt::request();
-                shared.shutdown.store(true, Ordering::SeqCst);
-                shared.reply(
-                    control,
-                    &msg,
-                    "shutdown_reply",
-                    json!({"status": "ok", "restart": restart}),
-                );
+                shared.shut_down(control, &msg);
                 shared.publish(Some(&msg), "status", json!({"execution_state": "idle"}));
             }
             "kernel_info_request" => {
@@ -391,16 +399,7 @@ fn handle_shell(
             "comm_info_reply",
             json!({"status": "ok", "comms": {}}),
         ),
-        "shutdown_request" => {
-            let restart = msg.content["restart"].as_bool().unwrap_or(false);
-            shared.shutdown.store(true, Ordering::SeqCst);
-            shared.reply(
-                shell,
-                msg,
-                "shutdown_reply",
-                json!({"status": "ok", "restart": restart}),
-            );
-        }
+        "shutdown_request" => shared.shut_down(shell, msg),
         other => eprintln!("swimlab kernel: no handler for \"{other}\" on the shell channel"),
     }
 }
