@@ -163,7 +163,7 @@ fn suspension(model: Model, phi: f64) -> Scene {
         &mut s,
         1000,
         d,
-        side,
+        [side; 3],
         Orientations::Random,
         Phases::Random,
         7,

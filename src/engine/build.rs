@@ -75,19 +75,22 @@ pub fn box_side(n: usize, d: &Dumbbell, phi: f64) -> Result<f64> {
     Ok((n as f64 * v / phi).cbrt())
 }
 
-/// `n` copies of `d` placed uniformly at random in a cube of side `side` (m) centred on the
-/// origin, every sphere gap wider than the strokes can close, with the given orientations and phases: random sequential
-/// addition from the generator seeded with `seed`.
+/// `n` copies of `d` placed uniformly at random in a box of sides `sides` (m) centred on the
+/// origin (the scene's periodic box, or a region of open space), every sphere gap wider than the
+/// strokes can close (by minimum images in a periodic box), with the given orientations and
+/// phases: random sequential addition from the generator seeded with `seed`.
 pub fn random_suspension(
     scene: &mut Scene,
     n: usize,
     d: Dumbbell,
-    side: f64,
+    sides: [f64; 3],
     orientations: Orientations,
     phases: Phases,
     seed: u64,
 ) -> Result<()> {
-    require_positive("box side", side, "m")?;
+    for side in sides {
+        require_positive("box side", side, "m")?;
+    }
     if n > MAX_RANDOM_SWIMMERS {
         return Err(invalid!(
             "cannot place {n} swimmers at random in one call: placement checks every new swimmer against all placed ones (n^2/2 checks), so one call places at most {MAX_RANDOM_SWIMMERS}; place more on a lattice"
@@ -107,7 +110,8 @@ pub fn random_suspension(
                 "placed only {placed} of {n} swimmers without overlaps after {max_tries} tries; use a larger box or a lower volume fraction"
             ));
         }
-        let c = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5) * side;
+        let u = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5);
+        let c = u.component_mul(&Vector3::from(sides));
         let dir = match orientations {
             Orientations::Random => rng.unit_vector(),
             Orientations::Aligned(v) => v,

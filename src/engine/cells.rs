@@ -9,9 +9,14 @@
 //! the points, not on the thread count; they differ from an all-pairs loop in index order by the
 //! rounding of the sum's order.
 
+use super::periodic::PeriodicBox;
 use std::collections::HashMap;
 
 /// Points binned into cubic cells of side `size`, and ordered cell by cell.
+///
+/// In a periodic box the cells tile the box (n_d = ⌊L_d/size⌋ of side L_d/n_d ≥ size per axis) and
+/// the neighbours wrap around its faces; a pass measures its pairs by their minimum image. Every
+/// point within `size` ≤ L/2 of another is then among the 27 cells around it.
 #[derive(Debug, Clone, Default)]
 pub struct CellGrid {
     size: f64,
@@ -19,40 +24,84 @@ pub struct CellGrid {
     pub order: Vec<u32>,
     /// Each occupied cell's run `start..end` in `order`.
     runs: HashMap<[i64; 3], (u32, u32)>,
+    /// In a box: its sides and the cells per axis.
+    periodic: Option<([f64; 3], [i64; 3])>,
 }
 
 impl CellGrid {
     /// Bin the points (x[i], y[i], z[i]) into cells of side `size` (m, positive and finite).
     pub fn build(x: &[f64], y: &[f64], z: &[f64], size: f64) -> Self {
-        let keys: Vec<[i64; 3]> = (0..x.len())
-            .map(|i| Self::key(size, x[i], y[i], z[i]))
-            .collect();
-        let mut order: Vec<u32> = (0..x.len() as u32).collect();
-        order.sort_by_key(|&i| (keys[i as usize], i));
-        let mut runs = HashMap::new();
+        Self::build_in(x, y, z, size, None)
+    }
+
+    /// [`CellGrid::build`] in periodic box `periodic`, if any.
+    pub fn build_in(
+        x: &[f64],
+        y: &[f64],
+        z: &[f64],
+        size: f64,
+        periodic: Option<&PeriodicBox>,
+    ) -> Self {
+        let periodic = periodic.map(|b| {
+            let l = b.sides();
+            (l, l.map(|side| ((side / size).floor() as i64).max(1)))
+        });
+        let mut grid = CellGrid {
+            size,
+            order: (0..x.len() as u32).collect(),
+            runs: HashMap::new(),
+            periodic,
+        };
+        let keys: Vec<[i64; 3]> = (0..x.len()).map(|i| grid.key(x[i], y[i], z[i])).collect();
+        grid.order.sort_by_key(|&i| (keys[i as usize], i));
+        let order = &grid.order;
         let mut start = 0;
         for k in 1..=order.len() {
             if k == order.len() || keys[order[k] as usize] != keys[order[start] as usize] {
-                runs.insert(keys[order[start] as usize], (start as u32, k as u32));
+                grid.runs
+                    .insert(keys[order[start] as usize], (start as u32, k as u32));
                 start = k;
             }
         }
-        CellGrid { size, order, runs }
+        grid
     }
 
-    fn key(size: f64, x: f64, y: f64, z: f64) -> [i64; 3] {
-        [x, y, z].map(|c| (c / size).floor() as i64)
+    fn key(&self, x: f64, y: f64, z: f64) -> [i64; 3] {
+        match self.periodic {
+            None => [x, y, z].map(|c| (c / self.size).floor() as i64),
+            Some((l, n)) => {
+                let c = [x, y, z];
+                std::array::from_fn(|d| {
+                    let f = (c[d] / l[d] + 0.5).rem_euclid(1.0);
+                    ((f * n[d] as f64).floor() as i64).clamp(0, n[d] - 1)
+                })
+            }
+        }
     }
 
     /// Into `out` (cleared first), the runs in [`CellGrid::order`] of the 27 cells around
     /// (x, y, z), in a fixed order: they hold every point within `size` of it.
     pub fn neighbour_runs(&self, x: f64, y: f64, z: f64, out: &mut Vec<(u32, u32)>) {
         out.clear();
-        let [i, j, k] = Self::key(self.size, x, y, z);
+        let [i, j, k] = self.key(x, y, z);
+        let mut seen: Vec<[i64; 3]> = Vec::new();
         for di in -1..=1 {
             for dj in -1..=1 {
                 for dk in -1..=1 {
-                    if let Some(&r) = self.runs.get(&[i + di, j + dj, k + dk]) {
+                    let mut cell = [i + di, j + dj, k + dk];
+                    if let Some((_, n)) = self.periodic {
+                        for (c, n) in cell.iter_mut().zip(n) {
+                            *c = c.rem_euclid(n);
+                        }
+                        // Fewer than 3 cells along an axis: the wrapped neighbours repeat.
+                        if n.iter().any(|&n| n < 3) {
+                            if seen.contains(&cell) {
+                                continue;
+                            }
+                            seen.push(cell);
+                        }
+                    }
+                    if let Some(&r) = self.runs.get(&cell) {
                         out.push(r);
                     }
                 }

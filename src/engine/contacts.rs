@@ -13,6 +13,7 @@
 
 use super::choice::{self, Choice, Named};
 use super::error::{invalid, Result};
+use super::periodic::{separation, PeriodicBox};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -93,10 +94,11 @@ impl Steric {
         &self,
         pos: &[Vector3<f64>],
         radii: &[f64],
+        periodic: Option<&PeriodicBox>,
         i: usize,
         j: usize,
     ) -> Option<Vector3<f64>> {
-        let r = pos[i] - pos[j];
+        let r = separation(periodic, pos[i] - pos[j]);
         // Compare squares first: the square root is taken for the few close pairs only.
         let reach = self.range + radii[i] + radii[j];
         let d2 = r.norm_squared();
@@ -108,25 +110,29 @@ impl Steric {
 
     /// Adds the repulsion on every sphere to `forces`. Sphere α belongs to swimmer α/2; spheres of
     /// one swimmer do not repel. Each row sums its own partners in index order (no scatter), so
-    /// rows run in parallel when `parallel` with results independent of the thread count.
+    /// rows run in parallel when `parallel` with results independent of the thread count. In a
+    /// periodic box pairs are measured by their minimum image.
     pub(crate) fn add_forces(
         &self,
         pos: &[Vector3<f64>],
         radii: &[f64],
+        periodic: Option<&PeriodicBox>,
         forces: &mut [Vector3<f64>],
         parallel: bool,
     ) {
         let row = |i: usize, f: &mut Vector3<f64>| {
             for j in 0..pos.len() {
                 if j / 2 != i / 2 {
-                    if let Some(df) = self.pair_force(pos, radii, i, j) {
+                    if let Some(df) = self.pair_force(pos, radii, periodic, i, j) {
                         *f += df;
                     }
                 }
             }
         };
-        if pos.len() >= super::pairs::CELL_LIST_SPHERES {
-            return self.add_forces_by_cells(pos, radii, forces, parallel);
+        let reach_max = self.range + 2.0 * radii.iter().copied().fold(0.0, f64::max);
+        let fits = periodic.is_none_or(|b| reach_max <= 0.5 * b.shortest());
+        if pos.len() >= super::pairs::CELL_LIST_SPHERES && fits {
+            return self.add_forces_by_cells(pos, radii, periodic, forces, parallel);
         }
         if parallel {
             forces
@@ -145,12 +151,19 @@ impl Steric {
         &self,
         pos: &[Vector3<f64>],
         radii: &[f64],
+        periodic: Option<&PeriodicBox>,
         forces: &mut [Vector3<f64>],
         parallel: bool,
     ) {
         let reach_max = self.range + 2.0 * radii.iter().copied().fold(0.0, f64::max);
         let coords = |k: usize| -> Vec<f64> { pos.iter().map(|p| p[k]).collect() };
-        let grid = super::cells::CellGrid::build(&coords(0), &coords(1), &coords(2), reach_max);
+        let grid = super::cells::CellGrid::build_in(
+            &coords(0),
+            &coords(1),
+            &coords(2),
+            reach_max,
+            periodic,
+        );
         let row = |i: usize, f: &mut Vector3<f64>| {
             let mut runs = Vec::with_capacity(27);
             grid.neighbour_runs(pos[i].x, pos[i].y, pos[i].z, &mut runs);
@@ -159,7 +172,7 @@ impl Steric {
                 for &j in &grid.order[a as usize..b as usize] {
                     let j = j as usize;
                     if j / 2 != i / 2 {
-                        if let Some(df) = self.pair_force(pos, radii, i, j) {
+                        if let Some(df) = self.pair_force(pos, radii, periodic, i, j) {
                             close.push((j, df));
                         }
                     }
@@ -206,7 +219,7 @@ mod tests {
             .collect();
         let st = Steric::new(1e-6, 1e-3).unwrap();
         let mut by_cells = vec![Vector3::zeros(); n];
-        st.add_forces(&pos, &radii, &mut by_cells, true);
+        st.add_forces(&pos, &radii, None, &mut by_cells, true);
         let mut all = vec![Vector3::zeros(); n];
         // The all-pairs loop, as add_forces runs it below the threshold.
         for i in 0..n {

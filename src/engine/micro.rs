@@ -46,6 +46,13 @@ impl MicroSystem {
         }
     }
 
+    /// Put the swimmers in the periodic box of `ewald` (its sums give the mobility). The stiff
+    /// own-pair rates behind rosw's Jacobian stay open space's: a W-method needs only an
+    /// approximate Jacobian, and a box longer than the swimmer changes the own pair little.
+    pub fn set_periodic(&mut self, ewald: Option<crate::engine::ewald::Ewald>) {
+        self.spheres.set_periodic(ewald);
+    }
+
     /// Thermal noise at `thermal`'s temperature (none at 0 K).
     pub fn set_thermal(&mut self, thermal: Thermal) {
         self.thermal = thermal.is_on().then_some(thermal);
@@ -53,8 +60,7 @@ impl MicroSystem {
 
     /// The full mobility matrix at the current sphere positions and its Cholesky factor L.
     fn mobility_factor(&self) -> Result<DMatrix<f64>, Problem> {
-        let sp = &self.spheres;
-        let m = sp.mobility.matrix(sp.mu, &sp.pos, &sp.radii);
+        let m = self.spheres.mobility_matrix();
         m.cholesky().map(|c| c.unpack()).ok_or_else(not_positive)
     }
 

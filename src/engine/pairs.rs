@@ -13,6 +13,7 @@
 //! serves small scenes.
 
 use super::mobility::Mobility;
+use super::periodic::PeriodicBox;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -40,6 +41,9 @@ pub struct SoaSpheres {
     pub fy: Vec<f64>,
     /// z force.
     pub fz: Vec<f64>,
+    /// The periodic box the spheres sit in, if any: the gap passes measure minimum images (the
+    /// RPY kernel here is open space's; a box's mobility is [`super::ewald`]'s).
+    pub periodic: Option<PeriodicBox>,
 }
 
 impl SoaSpheres {
@@ -73,6 +77,16 @@ impl SoaSpheres {
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
+    }
+
+    /// x_i − x_j as (x, y, z), its minimum image in a box.
+    #[inline]
+    fn delta(&self, i: usize, j: usize) -> (f64, f64, f64) {
+        let (rx, ry, rz) = (self.x[i] - self.x[j], self.y[i] - self.y[j], self.z[i] - self.z[j]);
+        match &self.periodic {
+            None => (rx, ry, rz),
+            Some(b) => (b.image(rx, 0), b.image(ry, 1), b.image(rz, 2)),
+        }
     }
 }
 
@@ -280,9 +294,13 @@ fn min_gap_by_cells(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f6
             });
         (hi - lo).max(0.0)
     };
-    let volume = extent(&s.x) * extent(&s.y) * extent(&s.z);
+    let volume = match &s.periodic {
+        Some(b) => b.volume(),
+        None => extent(&s.x) * extent(&s.y) * extent(&s.z),
+    };
     let side = (2.0 * (volume / n as f64).cbrt()).max(2.0 * a_max);
-    if !(side > 0.0 && side.is_finite()) {
+    let fits = s.periodic.is_none_or(|b| side <= 0.5 * b.shortest());
+    if !(side > 0.0 && side.is_finite() && fits) {
         return None;
     }
     let found = closest_in_cells(s, radii, side, parallel, |_| true)?;
@@ -294,7 +312,7 @@ fn min_gap_all_pairs(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f
     let row = |i: usize| -> Option<(f64, usize, usize)> {
         let mut best: Option<(f64, usize, usize)> = None;
         for j in i + 1..n {
-            let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
+            let (rx, ry, rz) = s.delta(i, j);
             let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
             if best.is_none_or(|b| gap < b.0) {
                 best = Some((gap, i, j));
@@ -332,7 +350,8 @@ pub fn closest_overlap(
 ) -> Option<(f64, usize, usize)> {
     let n = s.len();
     let reach = 2.0 * radii.iter().copied().fold(0.0, f64::max);
-    if n < CELL_LIST_SPHERES || !(reach > 0.0 && reach.is_finite()) {
+    let fits = s.periodic.is_none_or(|b| reach <= 0.5 * b.shortest());
+    if n < CELL_LIST_SPHERES || !(reach > 0.0 && reach.is_finite() && fits) {
         return min_gap_all_pairs(s, radii, parallel).filter(|g| g.0 <= 0.0);
     }
     closest_in_cells(s, radii, reach, parallel, |gap| gap <= 0.0)
@@ -349,7 +368,8 @@ fn closest_in_cells(
     keep: impl Fn(f64) -> bool + Sync,
 ) -> Option<(f64, usize, usize)> {
     let n = s.len();
-    let grid = super::cells::CellGrid::build(&s.x[..n], &s.y[..n], &s.z[..n], side);
+    let grid =
+        super::cells::CellGrid::build_in(&s.x[..n], &s.y[..n], &s.z[..n], side, s.periodic.as_ref());
     let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
         if (b.0, b.1, b.2) < (a.0, a.1, a.2) {
             b
@@ -367,7 +387,7 @@ fn closest_in_cells(
                 if j <= i {
                     continue;
                 }
-                let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
+                let (rx, ry, rz) = s.delta(i, j);
                 let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
                 if keep(gap) {
                     best = Some(best.map_or((gap, i, j), |x| first(x, (gap, i, j))));

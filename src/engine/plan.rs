@@ -29,10 +29,12 @@ pub fn backend_info(s: &Scene) -> Result<String> {
     plan(s).map(|p| p.to_string())
 }
 
-/// The options the device kernels do not have: contact handling, the cutoff, thermal noise.
+/// The options the device kernels do not have: a periodic box, contact handling, the cutoff,
+/// thermal noise.
 fn gpu_options_supported(s: &Scene) -> std::result::Result<(), String> {
     let cpu_only = |what: &str| Err(format!("{what} runs on the CPU only"));
     match s.model() {
+        _ if s.periodic().is_some() => cpu_only("a periodic box (Ewald sums, minimum images)"),
         _ if s.thermal().is_on() => cpu_only("thermal noise (temperature above 0)"),
         _ if s.contacts() != Contacts::default() => {
             cpu_only("contact handling (overlaps allowed, steric repulsion)")

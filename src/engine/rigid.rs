@@ -12,7 +12,7 @@
 
 use super::contacts::Contacts;
 use super::integrators::{OdeSystem, Problem};
-use super::mobility::{self_mobility, Mobility};
+use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
@@ -66,14 +66,12 @@ impl RigidSystem {
 
     /// H_αβ v for spheres α, β (self term when α = β).
     fn h(&self, alpha: usize, beta: usize, v: &Vector3<f64>) -> Vector3<f64> {
-        let sp = &self.spheres;
-        if alpha == beta {
-            v * self_mobility(sp.mu, sp.radii[alpha])
-        } else {
-            let r = sp.pos[alpha] - sp.pos[beta];
-            sp.mobility
-                .pair_apply(sp.mu, &r, sp.radii[alpha], sp.radii[beta], v)
-        }
+        self.spheres.block_apply(alpha, beta, v)
+    }
+
+    /// Put the swimmers in the periodic box of `ewald` (its sums give the mobility).
+    pub fn set_periodic(&mut self, ewald: Option<crate::engine::ewald::Ewald>) {
+        self.spheres.set_periodic(ewald);
     }
 
     /// The constraint tensions at time `t` (N), in swimmer order.

@@ -9,6 +9,8 @@
 use super::averaged::AveragedSystem;
 use super::backend::Backend;
 use super::contacts::{Contacts, Overlaps, Steric};
+use super::ewald::{Ewald, DEFAULT_EWALD_TOL};
+use super::periodic::{separation, PeriodicBox};
 use super::error::{invalid, require_finite, require_positive, unsupported, Result, Setting};
 use super::integrators::{IntegratorSpec, OdeSystem, Stats};
 use super::micro::MicroSystem;
@@ -55,6 +57,19 @@ fn lcm(a: u64, b: u64) -> u64 {
     a / gcd(a, b) * b
 }
 
+/// Swimmer `d` must not reach its own image: the box's shortest side above 2(ℓ + λ + a1 + a2).
+fn check_fits_box(d: &Dumbbell, b: &PeriodicBox) -> Result<()> {
+    let reach = d.ell + d.lambda + d.a1 + d.a2;
+    if b.shortest() <= 2.0 * reach {
+        return Err(invalid!(
+            "a box side of {:e} m is too short for a swimmer of reach ell + lambda + a1 + a2 = {reach:e} m, which would meet its own image; make every side longer than {:e} m",
+            b.shortest(),
+            2.0 * reach
+        ));
+    }
+    Ok(())
+}
+
 /// Default tolerance of the averaged model's adaptive integrator.
 pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 
@@ -91,6 +106,20 @@ pub struct Scene {
     /// Temperature and noise seed (saved unless all default, so noise-free files are unchanged).
     #[serde(default, skip_serializing_if = "Thermal::is_default")]
     thermal: Thermal,
+    /// The periodic box; `None`: open space (saved only when set).
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    periodic: Option<PeriodicBox>,
+    /// Tolerance of the box's Ewald sums (saved only when not the default).
+    #[serde(default = "default_ewald_tol", skip_serializing_if = "is_default_ewald_tol")]
+    ewald_tol: f64,
+}
+
+fn default_ewald_tol() -> f64 {
+    DEFAULT_EWALD_TOL
+}
+
+fn is_default_ewald_tol(t: &f64) -> bool {
+    *t == DEFAULT_EWALD_TOL
 }
 
 impl Default for Scene {
@@ -110,6 +139,8 @@ impl Default for Scene {
             stats: Stats::default(),
             backend: Backend::default(),
             thermal: Thermal::default(),
+            periodic: None,
+            ewald_tol: DEFAULT_EWALD_TOL,
         }
     }
 }
@@ -180,12 +211,15 @@ impl Scene {
             require_finite(&format!("center.{k}"), *c)?;
         }
         let n = unit_direction(dir)?;
+        if let Some(b) = &self.periodic {
+            check_fits_box(d, b)?;
+        }
         let (x1, x2) = d.sphere_positions(center, n, self.contact_length(d));
         for (s, other) in self.swimmers.iter().enumerate() {
             let (y1, y2) = self.spheres(s);
             for (xa, aa) in [(x1, d.a1), (x2, d.a2)] {
                 for (yb, ab) in [(y1, other.a1), (y2, other.a2)] {
-                    let gap = (xa - yb).norm() - aa - ab;
+                    let gap = separation(self.periodic.as_ref(), xa - yb).norm() - aa - ab;
                     if gap <= margin {
                         return Err(invalid!(
                             "the new swimmer would overlap swimmer {s} (sphere gap {gap:.3e} m); place its centre further away"
@@ -289,6 +323,66 @@ impl Scene {
         }
         self.cutoff = cutoff;
         Ok(())
+    }
+
+    /// The periodic box, if any (`None`: open space).
+    pub fn periodic(&self) -> Option<&PeriodicBox> {
+        self.periodic.as_ref()
+    }
+
+    /// Put the scene in a periodic box of sides `sides` (m), centred on the origin, or (`None`)
+    /// back in open space. Every swimmer must fit (a box side longer than twice its reach
+    /// ℓ + λ + a1 + a2, so that it never meets its own image) and no spheres may overlap by their
+    /// minimum images; otherwise the scene is unchanged and the error says which.
+    pub fn set_box(&mut self, sides: Option<[f64; 3]>) -> Result<()> {
+        let Some(sides) = sides else {
+            self.periodic = None;
+            return Ok(());
+        };
+        let b = PeriodicBox::new(sides)?;
+        for (i, d) in self.swimmers.iter().enumerate() {
+            check_fits_box(d, &b).map_err(|e| invalid!("swimmer {i}: {e}"))?;
+        }
+        let old = self.periodic.replace(b);
+        if let Some((gap, a, c)) = self.closest_spheres() {
+            if gap <= 0.0 && !(self.contacts.allow_overlap && a / 2 != c / 2) {
+                self.periodic = old;
+                return Err(invalid!(
+                    "in that box sphere {a} (swimmer {}) would overlap the image of sphere {c} (swimmer {}) by {:.3e} m; use a larger box or move the swimmers",
+                    a / 2,
+                    c / 2,
+                    -gap
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility.
+    pub fn ewald_tol(&self) -> f64 {
+        self.ewald_tol
+    }
+
+    /// Set the tolerance of the box's Ewald sums (1e-15 to 1e-2).
+    pub fn set_ewald_tol(&mut self, tol: f64) -> Result<()> {
+        crate::engine::ewald::check_tol(tol)?;
+        self.ewald_tol = tol;
+        Ok(())
+    }
+
+    /// The box's periodic mobility for the sphere models (`None` in open space).
+    pub(crate) fn ewald(&self) -> Result<Option<Ewald>> {
+        self.periodic
+            .map(|b| Ewald::new(b, self.mu, self.mobility, 2 * self.count(), self.ewald_tol, None))
+            .transpose()
+    }
+
+    /// Position `p` as shown: wrapped into the box, if there is one.
+    pub fn shown(&self, p: Vector3<f64>) -> Vector3<f64> {
+        match &self.periodic {
+            Some(b) => b.wrap(p),
+            None => p,
+        }
     }
 
     /// Temperature, noise seed and how the noise's square root is taken.
@@ -439,6 +533,7 @@ impl Scene {
         let n = 2 * self.count();
         let mut soa = super::pairs::SoaSpheres::default();
         soa.resize(n);
+        soa.periodic = self.periodic;
         let mut radii = Vec::with_capacity(n);
         for i in 0..self.count() {
             let (a, b) = self.spheres(i);
@@ -592,7 +687,8 @@ impl Scene {
 
     /// Sphere velocities (m/s) for given sphere forces (N), one per sphere, swimmer by swimmer
     /// (the a1 sphere first), with the scene's mobility and viscosity at the present sphere
-    /// positions: v_α = F_α/(6πμa_α) + Σ_{β≠α} H_αβ F_β. For checks against other codes.
+    /// positions: v_α = F_α/(6πμa_α) + Σ_{β≠α} H_αβ F_β; in a box the periodic mobility (Ewald
+    /// sums, no net flow). For checks against other codes.
     pub fn sphere_velocities(&self, forces: &[Vector3<f64>]) -> Result<Vec<Vector3<f64>>> {
         let n = 2 * self.count();
         if forces.len() != n {
@@ -616,8 +712,12 @@ impl Scene {
             radii.extend([d.a1, d.a2]);
         }
         let mut v = vec![Vector3::zeros(); n];
-        self.mobility
-            .interaction_velocities(self.mu, &pos, &radii, forces, &mut v);
+        match self.ewald()? {
+            Some(e) => e.interaction_velocities(&pos, &radii, forces, &mut v),
+            None => self
+                .mobility
+                .interaction_velocities(self.mu, &pos, &radii, forces, &mut v),
+        }
         for ((vi, f), a) in v.iter_mut().zip(forces).zip(&radii) {
             *vi += f * super::mobility::self_mobility(self.mu, *a);
         }

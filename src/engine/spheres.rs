@@ -3,6 +3,8 @@
 //! Sphere 2σ is dumbbell σ's a1 sphere, 2σ+1 its a2 sphere.
 
 use super::contacts::Contacts;
+use super::ewald::Ewald;
+use super::periodic::{separation, PeriodicBox};
 use super::integrators::Problem;
 use super::mobility::{self_mobility, Mobility};
 use super::pairs::{self, SoaSpheres};
@@ -28,6 +30,8 @@ pub(crate) struct Spheres {
     /// Scratch of the fast kernel (large scenes).
     soa: SoaSpheres,
     soa_u: Vec<[f64; 3]>,
+    /// In a periodic box: the Ewald-summed mobility (its box also sets the minimum images).
+    ewald: Option<Ewald>,
 }
 
 /// From this many spheres on, the vectorised row kernel ([`pairs`]) replaces the symmetric
@@ -61,6 +65,38 @@ impl Spheres {
             u: vec![Vector3::zeros(); n],
             soa: SoaSpheres::default(),
             soa_u: Vec::new(),
+            ewald: None,
+        }
+    }
+
+    /// Put the spheres in the periodic box of `ewald`, whose sums then give the mobility.
+    pub(crate) fn set_periodic(&mut self, ewald: Option<Ewald>) {
+        self.soa.periodic = ewald.as_ref().map(|e| *e.periodic());
+        self.ewald = ewald;
+    }
+
+    /// The periodic box, if any.
+    pub(crate) fn periodic(&self) -> Option<&PeriodicBox> {
+        self.ewald.as_ref().map(Ewald::periodic)
+    }
+
+    /// H_αβ v for spheres α, β (α = β: the self block, Stokes drag included), with the box's
+    /// periodic mobility in a box.
+    pub(crate) fn block_apply(&self, alpha: usize, beta: usize, v: &Vector3<f64>) -> Vector3<f64> {
+        let r = self.pos[alpha] - self.pos[beta];
+        let (ai, aj) = (self.radii[alpha], self.radii[beta]);
+        match &self.ewald {
+            Some(e) => e.block(&e.periodic().min_image(r), ai, aj, alpha == beta) * v,
+            None if alpha == beta => v * self_mobility(self.mu, ai),
+            None => self.mobility.pair_apply(self.mu, &r, ai, aj, v),
+        }
+    }
+
+    /// The full mobility matrix at the current positions (the box's periodic one in a box).
+    pub(crate) fn mobility_matrix(&self) -> nalgebra::DMatrix<f64> {
+        match &self.ewald {
+            Some(e) => e.matrix(&self.pos, &self.radii),
+            None => self.mobility.matrix(self.mu, &self.pos, &self.radii),
         }
     }
 
@@ -83,6 +119,7 @@ impl Spheres {
             st.add_forces(
                 &self.pos,
                 &self.radii,
+                self.ewald.as_ref().map(Ewald::periodic),
                 &mut self.steric,
                 n >= PARALLEL_SPHERES,
             );
@@ -112,6 +149,10 @@ impl Spheres {
     /// u_α = Σ_{β≠α} H_αβ F_β for the forces set.
     fn pair_velocities(&mut self) {
         let n = self.pos.len();
+        if let Some(e) = &self.ewald {
+            e.interaction_velocities(&self.pos, &self.radii, &self.forces, &mut self.u);
+            return;
+        }
         if n < FAST_KERNEL_SPHERES {
             self.mobility.interaction_velocities(
                 self.mu,
@@ -187,11 +228,11 @@ impl Spheres {
             return pairs::closest_overlap(&self.soa, &self.radii, parallel)
                 .map(|(gap, a, b)| overlap_problem(gap, a, b));
         }
-        let (pos, radii) = (&self.pos, &self.radii);
+        let (pos, radii, periodic) = (&self.pos, &self.radii, self.periodic());
         let n = pos.len();
         for a in 0..n {
             for b in (a + 1)..n {
-                let gap = (pos[a] - pos[b]).norm() - radii[a] - radii[b];
+                let gap = separation(periodic, pos[a] - pos[b]).norm() - radii[a] - radii[b];
                 if gap <= 0.0 {
                     return Some(overlap_problem(gap, a, b));
                 }

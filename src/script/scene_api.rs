@@ -109,12 +109,19 @@ pub fn summary(s: &Scene) -> String {
         b => format!(", backend = \"{}\"", b.name()),
     };
     let thermal = thermal_summary(s);
+    let periodic = s
+        .periodic()
+        .map(|b| {
+            let [x, y, z] = b.sides();
+            format!(", box = [{x:e}, {y:e}, {z:e}] m")
+        })
+        .unwrap_or_default();
     let period = s
         .period()
         .map(|t| format!(", T = {t:.6e} s"))
         .unwrap_or_default();
     format!(
-        "Scene({} swimmers, model = \"{}\", mobility = \"{}\", integrator = {}{}, mu = {:e} Pa s, t = {:.6e} s{period}{backend}{thermal})",
+        "Scene({} swimmers, model = \"{}\", mobility = \"{}\", integrator = {}{}, mu = {:e} Pa s, t = {:.6e} s{period}{periodic}{backend}{thermal})",
         s.count(),
         s.model().name(),
         s.mobility().name(),
@@ -143,7 +150,21 @@ fn add_random(
             "add_random: the number of swimmers must be >= 0, got {n}"
         )));
     }
-    let phi = number("add_random: volume fraction", phi)?;
+    let in_box = s.borrow().scene().periodic().map(|b| b.sides());
+    let phi = match (in_box, phi.is_unit()) {
+        (Some(_), false) => {
+            return Err(script_error(
+                "add_random: the scene has a periodic box, whose volume sets the volume fraction: use s.add_random(d, n, seed) to fill it".to_string(),
+            ))
+        }
+        (None, true) => {
+            return Err(script_error(
+                "add_random: in open space give a volume fraction, s.add_random(d, n, volume_fraction, seed), or set a box first (s.box = [Lx, Ly, Lz]) and fill it with s.add_random(d, n, seed)".to_string(),
+            ))
+        }
+        (_, true) => 0.0,
+        (None, false) => number("add_random: volume fraction", phi)?,
+    };
     let mut orientations = Orientations::Random;
     let mut phases = Phases::Random;
     for (k, v) in opts {
@@ -158,12 +179,15 @@ fn add_random(
         }
     }
     let mut trial = s.borrow().scene().clone();
-    let side = lift(box_side(n as usize, &d.params, phi))?;
+    let sides = match in_box {
+        Some(l) => l,
+        None => [lift(box_side(n as usize, &d.params, phi))?; 3],
+    };
     lift(random_suspension(
         &mut trial,
         n as usize,
         d.params,
-        side,
+        sides,
         orientations,
         phases,
         seed as u64,
@@ -245,6 +269,19 @@ pub fn register(engine: &mut Engine) {
          seed: INT,
          opts: rhai::Map|
          -> ScriptResult<INT> { add_random(s, d, n, &phi, seed, &opts) },
+    );
+    // In a periodic box, whose volume sets the volume fraction.
+    engine.register_fn(
+        "add_random",
+        |s: &mut SceneHandle, d: DumbbellSpec, n: INT, seed: INT| -> ScriptResult<INT> {
+            add_random(s, d, n, &Dynamic::UNIT, seed, &rhai::Map::new())
+        },
+    );
+    engine.register_fn(
+        "add_random",
+        |s: &mut SceneHandle, d: DumbbellSpec, n: INT, seed: INT, opts: rhai::Map| -> ScriptResult<INT> {
+            add_random(s, d, n, &Dynamic::UNIT, seed, &opts)
+        },
     );
 
     engine.register_fn(
@@ -449,7 +486,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("phase", "phases", "phase(x) -> float\ns.phase(i) -> float", "phase(x): x radians wrapped to [0, 2 pi). s.phase(i): the stroke phase of swimmer i.", "print(phase(7.0)); let s = scene(); s.add(dumbbell(#{ phase: 1.0 })); print(s.phase(0));"),
     doc_entry!("phases", "phases", "s.phases -> array\ns.phases = [..]", "All stroke phases (rad) in swimmer order; assign one per swimmer.", docs::PAIR_PHASES),
     doc_entry!("set_phase", "phases", "s.set_phase(i, phi)", "Set the stroke phase of swimmer i (rad).", "let s = scene(); s.add(dumbbell()); s.set_phase(0, pi()); print(s.phases);"),
-    doc_entry!("add_random", "scene", "s.add_random(d, n, volume_fraction, seed) -> int\ns.add_random(d, n, volume_fraction, seed, #{ aligned: [x, y, z], phase: p }) -> int", "Add n copies of dumbbell d at random places in a cube centred on the origin, sized so that all spheres fill the given volume fraction, without overlaps (random sequential addition, seeded: the same seed gives the same scene). Orientations and phases are random unless fixed by the options. Returns the new swimmer count; on failure the scene is unchanged.", "let s = scene(); s.add_random(dumbbell(#{}), 20, 0.01, 1); print(s.count);"),
+    doc_entry!("add_random", "scene", "s.add_random(d, n, volume_fraction, seed) -> int\ns.add_random(d, n, volume_fraction, seed, #{ aligned: [x, y, z], phase: p }) -> int\ns.add_random(d, n, seed[, opts]) -> int  (in a periodic box)", "Add n copies of dumbbell d at random places in a cube centred on the origin, sized so that all spheres fill the given volume fraction (in a periodic box: the box itself, measured by minimum images), without overlaps (random sequential addition, seeded: the same seed gives the same scene). Orientations and phases are random unless fixed by the options. Returns the new swimmer count; on failure the scene is unchanged.", "let s = scene(); s.add_random(dumbbell(#{}), 20, 0.01, 1); print(s.count);"),
     doc_entry!("add_at", "scene", "s.add_at(d, centres: array) -> int", "Add a copy of dumbbell d (its orientation and phase) at every centre [x, y, z] (m) of the array, e.g. a lattice from the stdlib module \"lattice\". All or nothing: if one does not fit, the scene is unchanged. Returns the new swimmer count.", "import \"lattice\" as lattice; let s = scene(); s.add_at(dumbbell(), lattice::cubic(2, 2, 2, 20e-6)); print(s.count);"),
     doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
     doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),

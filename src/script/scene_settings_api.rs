@@ -206,6 +206,24 @@ pub fn register(engine: &mut Engine) {
             let c = if v.is_unit() { None } else { Some(number("s.cutoff", &v)?) };
             s.with_mut(|sc| sc.set_cutoff(c))
         })
+        .register_get("box", |s: &mut SceneHandle| match s.borrow().periodic() {
+            Some(b) => Dynamic::from_array(b.sides().iter().map(|&x| Dynamic::from_float(x)).collect()),
+            None => Dynamic::UNIT,
+        })
+        .register_set("box", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+            let sides = if v.is_unit() {
+                None
+            } else {
+                let l = super::convert::vector3("s.box", &v)?;
+                Some([l.x, l.y, l.z])
+            };
+            s.with_mut(|sc| sc.set_box(sides))
+        })
+        .register_get("ewald_tol", |s: &mut SceneHandle| s.borrow().ewald_tol())
+        .register_set("ewald_tol", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
+            let t = number("s.ewald_tol", &v)?;
+            s.with_mut(|sc| sc.set_ewald_tol(t))
+        })
         .register_get("integrator", |s: &mut SceneHandle| s.borrow().integrator())
         .register_get("integrator_info", |s: &mut SceneHandle| {
             s.with(|sc| sc.integrator_info()).map(ImmutableString::from)
@@ -247,6 +265,8 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("overlaps", "numerics", "s.overlaps -> string\ns.overlaps = \"stop\" | \"allow\"", "What happens when spheres of different swimmers touch: \"stop\" (default) ends the run with an error naming them; \"allow\" lets them overlap, moved by the RPY tensor for overlapping spheres (Zuk et al. 2014, positive definite; the averaged model, a far-field model, then runs on with its D^-5 terms). A swimmer's own spheres touching always stops the run. CPU only.", "let s = scene(); s.overlaps = \"allow\"; print(s.overlaps);"),
     doc_entry!("steric", "numerics", "s.steric -> map or ()\ns.steric = #{ range, stiffness } | ()", "A soft repulsion between spheres of different swimmers: force stiffness * (range - gap) (N) along the line of centres when their surface gap is below range (m). Off by default (). Microscopic model: the forces join the spring forces in the mobility. Averaged model: each swimmer moves as a free-draining rigid dumbbell of length ell under them. Not in the rigid-stroke model; CPU only; costs one O(N^2) pass per right-hand side.", "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3 }; print(s.steric.range);"),
     doc_entry!("cutoff", "numerics", "s.cutoff -> float or ()\ns.cutoff = distance | ()", "Far-field cutoff of the averaged model (m): pairs further apart are left out. Off by default (). Each left-out pair's contribution is bounded by 9/64 v0 (28|A_R|(Lambda/ell) xi^3 + 84 c_J xi^4) with xi = ell/cutoff (README, Suspensions).", "let s = scene(); s.cutoff = 100e-6; print(s.cutoff);"),
+    doc_entry!("box", "numerics", "s.box -> array or ()\ns.box = [Lx, Ly, Lz] | ()", "A periodic box of these sides (m) centred on the origin (-L/2 to L/2), or () for open space (the default). Pairs are measured by their minimum images; the sphere models use the periodic RPY (or Oseen) mobility by Ewald summation (Beenakker 1986, to s.ewald_tol, no net flow); the averaged model sums pairs within a cutoff of at most L/2 (L/2 when s.cutoff is not set). Snapshots, trajectories and fields show positions wrapped into the box; displacements and drift observables follow the unwrapped motion. add_random fills the box (s.add_random(d, n, seed)). CPU only. Saved with the scene.", "let s = scene(); s.box = [200e-6, 200e-6, 200e-6]; s.add_random(dumbbell(), 20, 1); print(s.box);"),
+    doc_entry!("ewald_tol", "numerics", "s.ewald_tol -> float\ns.ewald_tol = tol", "Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility (default 1e-10; 1e-15 to 1e-2). Both the real-space and the reciprocal sums are cut where their terms fall below it; the splitting is chosen for speed and the result does not depend on it.", "let s = scene(); s.ewald_tol = 1e-12; print(s.ewald_tol);"),
     doc_entry!("coefficients", "numerics", "s.coefficients -> string\ns.coefficients = \"paper\" | \"leading_order\"", "Coefficients of the averaged model's I and J terms: as published, or the leading-order ones.", "let s = scene(); s.coefficients = \"leading_order\"; print(s.coefficients);"),
     doc_entry!("integrator_info", "numerics", "s.integrator_info -> string", "What the integrator runs on this scene: for auto(tol) the method it chose and why, else the integrator and whether it is the model's default.", "let s = scene(); s.add(dumbbell()); s.integrator = auto(1e-3); print(s.integrator_info);"),
     doc_entry!("integrator", "numerics", "s.integrator -> Integrator\ns.integrator = euler(dt) | rk4(dt) | dopri5(rtol) | rosw(rtol) | stroboscopic(tol) | auto(tol) | \"default\"", "The time integrator. The default depends on the model and the scene's stiffness.", "let s = scene(); s.add(dumbbell()); print(s.integrator); s.integrator = rk4(5e-6); print(s.integrator);"),

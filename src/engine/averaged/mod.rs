@@ -24,6 +24,7 @@ use super::integrators::{Noise, OdeSystem, Problem};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, Coefficients, STATE_PER_SWIMMER};
 use super::pairs::SoaSpheres;
+use super::periodic::{separation, PeriodicBox};
 use super::swimmer::Dumbbell;
 use super::thermal::{RigidDiffusion, Thermal};
 use nalgebra::Vector3;
@@ -183,6 +184,8 @@ pub struct AveragedSystem {
     lanes: Option<bool>,
     /// Thermal noise: the seed and each swimmer's rigid-dumbbell diffusion.
     thermal: Option<(u64, Vec<RigidDiffusion>)>,
+    /// The periodic box, if any: pairs by minimum image (the scene requires a cutoff ≤ L/2).
+    periodic: Option<PeriodicBox>,
 }
 
 /// From this many swimmers the all-pairs rows are summed in vector lanes ([`lanes`]); below it
@@ -250,6 +253,7 @@ impl AveragedSystem {
             cell_soa: Soa::default(),
             cell_phase: Vec::new(),
             thermal: None,
+            periodic: None,
         };
         if shortcuts.aligned_1d {
             sys.axis = sys.common_axis(y);
@@ -272,6 +276,17 @@ impl AveragedSystem {
         };
         if contacts.steric.is_some() {
             // The 1D reduction has no sphere geometry.
+            self.axis = None;
+        }
+    }
+
+    /// Put the swimmers in periodic box `periodic`: every pair by its minimum image. The caller
+    /// sets a cutoff of at most half the shortest side, so a pair meets one image at most. The
+    /// 1D reduction and the all-pairs vector rows are open space's and are not used in a box.
+    pub fn set_periodic(&mut self, periodic: Option<PeriodicBox>) {
+        self.periodic = periodic;
+        self.gap_soa.periodic = periodic;
+        if periodic.is_some() {
             self.axis = None;
         }
     }
@@ -398,10 +413,13 @@ impl AveragedSystem {
         let mut t = Vector3::zeros();
         // Partner r's data from `src` at slot k (the arrays themselves, or their cell-ordered copy).
         let mut pair = |src: &Soa, k: usize, sin: f64| {
-            let dvec = Vector3::new(
-                soa.x[s] - src.x[k],
-                soa.y[s] - src.y[k],
-                soa.z[s] - src.z[k],
+            let dvec = separation(
+                self.periodic.as_ref(),
+                Vector3::new(
+                    soa.x[s] - src.x[k],
+                    soa.y[s] - src.y[k],
+                    soa.z[s] - src.z[k],
+                ),
             );
             let d2 = dvec.norm_squared();
             if d2 > self.cutoff2 {
@@ -502,8 +520,9 @@ impl AveragedSystem {
                 out[3..6].fill(0.0);
                 return;
             }
-            let vector =
-                self.grid.is_none() && self.lanes.unwrap_or(self.coef.len() >= LANE_SWIMMERS);
+            let vector = self.grid.is_none()
+                && self.periodic.is_none()
+                && self.lanes.unwrap_or(self.coef.len() >= LANE_SWIMMERS);
             let (mut v, t) = if vector {
                 lanes::row(self, s)
             } else {
@@ -550,7 +569,9 @@ impl OdeSystem for AveragedSystem {
                 let use_cells = self.cutoff2.is_finite()
                     && self.cells.unwrap_or(self.coef.len() >= CELL_LIST_SWIMMERS);
                 self.grid = use_cells.then(|| {
-                    CellGrid::build(&self.soa.x, &self.soa.y, &self.soa.z, self.cutoff2.sqrt())
+                    let soa = &self.soa;
+                    let side = self.cutoff2.sqrt();
+                    CellGrid::build_in(&soa.x, &soa.y, &soa.z, side, self.periodic.as_ref())
                 });
                 if let Some(g) = &self.grid {
                     // Refilled in place: the buffers are allocated once, not per right-hand side.
@@ -579,7 +600,8 @@ impl OdeSystem for AveragedSystem {
             // The sphere models' pair force, on the spheres at length ℓ.
             self.steric_f.fill(Vector3::zeros());
             let parallel = self.coef.len() >= PARALLEL_SWIMMERS;
-            st.add_forces(&self.sphere_pos, &self.radii, &mut self.steric_f, parallel);
+            let periodic = self.periodic.as_ref();
+            st.add_forces(&self.sphere_pos, &self.radii, periodic, &mut self.steric_f, parallel);
         }
         self.rows_into(y, dy);
     }

@@ -82,6 +82,7 @@ impl Scene {
                     self.contacts,
                 );
                 sys.set_thermal(self.thermal);
+                sys.set_periodic(self.ewald()?);
                 Box::new(sys)
             }
             Model::Rigid => {
@@ -91,24 +92,43 @@ impl Scene {
                         &[Setting::Model("micro"), Setting::Model("averaged"), Setting::NoSteric],
                     ));
                 }
-                Box::new(RigidSystem::new(
+                let mut sys = RigidSystem::new(
                     &self.swimmers,
                     &self.base,
                     self.mu,
                     self.mobility,
                     self.contacts.allow_overlap,
-                ))
+                );
+                sys.set_periodic(self.ewald()?);
+                Box::new(sys)
             }
             Model::Averaged => {
                 self.check_averaged()?;
                 let mut sys =
                     AveragedSystem::new(&self.swimmers, &self.base, self.coefficients, &self.state);
-                sys.set_cutoff(self.cutoff);
+                sys.set_cutoff(self.averaged_cutoff()?);
+                sys.set_periodic(self.periodic);
                 sys.set_contacts(self.contacts, self.mu);
                 sys.set_thermal(self.thermal, &self.swimmers, self.mu, self.mobility)?;
                 Box::new(sys)
             }
         })
+    }
+
+    /// The averaged model's cutoff: the one set; in a box at most half its shortest side (a pair
+    /// meets one image), and half that side when none is set.
+    pub fn averaged_cutoff(&self) -> Result<Option<f64>> {
+        let Some(b) = &self.periodic else {
+            return Ok(self.cutoff);
+        };
+        let half = 0.5 * b.shortest();
+        match self.cutoff {
+            None => Ok(Some(half)),
+            Some(c) if c <= half => Ok(Some(c)),
+            Some(c) => Err(invalid!(
+                "the averaged model's cutoff {c:e} m is longer than half the box's shortest side ({half:e} m): a pair would meet two images; set s.cutoff = {half:e} or less, or use a larger box"
+            )),
+        }
     }
 
     /// The averaged equations describe identical strokes: ω, λ and ℓ must agree.

@@ -85,6 +85,14 @@ impl Scene {
             Steric::new(st.range, st.stiffness)?;
         }
         self.thermal.validate()?;
+        crate::engine::ewald::check_tol(self.ewald_tol)?;
+        if let Some(b) = self.periodic {
+            let mut probe = Scene::new();
+            probe.set_box(Some(b.sides()))?;
+            for (i, d) in self.swimmers.iter().enumerate() {
+                super::check_fits_box(d, &b).map_err(|e| invalid!("swimmer {i}: {e}"))?;
+            }
+        }
         if let Some(c) = self.cutoff {
             let mut probe = Scene::new();
             probe.set_cutoff(Some(c))?;

@@ -1,0 +1,98 @@
+//! A periodic box centred on the origin (−L/2 … L/2 in each direction): minimum images and
+//! wrapping.
+//!
+//! The engine integrates the swimmers' unwrapped motion (displacements and drifts stay continuous
+//! across the box faces, as mean-square displacements need); every pair pass measures separations
+//! by their minimum image, and what is shown (snapshots, trajectories, fields) is wrapped into the
+//! box.
+
+use super::error::{invalid, Result};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// A rectangular periodic box of sides `l` (m), centred on the origin.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PeriodicBox {
+    l: [f64; 3],
+}
+
+impl PeriodicBox {
+    /// A box of sides `l` (m): each positive and finite.
+    pub fn new(l: [f64; 3]) -> Result<Self> {
+        for (k, v) in ["x", "y", "z"].iter().zip(l) {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid!(
+                    "the box side along {k} must be a positive length in m (e.g. s.box = [1e-3, 1e-3, 1e-3]), got {v}; or s.box = () for open space"
+                ));
+            }
+        }
+        Ok(PeriodicBox { l })
+    }
+
+    /// The sides (m).
+    pub fn sides(&self) -> [f64; 3] {
+        self.l
+    }
+
+    /// The shortest side (m).
+    pub fn shortest(&self) -> f64 {
+        self.l.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    /// The volume (m³).
+    pub fn volume(&self) -> f64 {
+        self.l[0] * self.l[1] * self.l[2]
+    }
+
+    /// The component `d` of a separation along axis `k`, moved to its nearest image
+    /// (−L/2 ≤ d ≤ L/2).
+    #[inline]
+    pub fn image(&self, d: f64, k: usize) -> f64 {
+        d - self.l[k] * (d / self.l[k]).round()
+    }
+
+    /// The minimum image of separation `r`.
+    #[inline]
+    pub fn min_image(&self, r: Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(self.image(r.x, 0), self.image(r.y, 1), self.image(r.z, 2))
+    }
+
+    /// Position `p` wrapped into the box (−L/2 ≤ x < L/2).
+    pub fn wrap(&self, p: Vector3<f64>) -> Vector3<f64> {
+        let w = |x: f64, l: f64| {
+            let y = x - l * ((x + 0.5 * l) / l).floor();
+            // Rounding can land a point just below −L/2 on L/2 exactly: keep the half-open range.
+            if y >= 0.5 * l {
+                y - l
+            } else {
+                y
+            }
+        };
+        Vector3::new(w(p.x, self.l[0]), w(p.y, self.l[1]), w(p.z, self.l[2]))
+    }
+}
+
+/// Separation `r` as the pair passes see it: its minimum image in a box, itself in open space.
+#[inline]
+pub fn separation(periodic: Option<&PeriodicBox>, r: Vector3<f64>) -> Vector3<f64> {
+    match periodic {
+        Some(b) => b.min_image(r),
+        None => r,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn images_and_wrapping() {
+        let b = PeriodicBox::new([2.0, 4.0, 8.0]).unwrap();
+        let r = b.min_image(Vector3::new(1.5, -3.0, 9.0));
+        assert_eq!(r, Vector3::new(-0.5, 1.0, 1.0));
+        let w = b.wrap(Vector3::new(1.0, -2.0, 13.0));
+        assert_eq!(w, Vector3::new(-1.0, -2.0, -3.0));
+        assert!(PeriodicBox::new([1.0, 0.0, 1.0]).is_err());
+        assert!(PeriodicBox::new([1.0, f64::NAN, 1.0]).is_err());
+    }
+}
