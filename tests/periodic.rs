@@ -51,7 +51,12 @@ fn random_spheres(
     (pos, radii, forces)
 }
 
-fn velocities(e: &Ewald, pos: &[Vector3<f64>], radii: &[f64], f: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+fn velocities(
+    e: &Ewald,
+    pos: &[Vector3<f64>],
+    radii: &[f64],
+    f: &[Vector3<f64>],
+) -> Vec<Vector3<f64>> {
     let mut u = vec![Vector3::zeros(); pos.len()];
     e.interaction_velocities(pos, radii, f, &mut u);
     u
@@ -62,7 +67,10 @@ fn max_norm(v: &[Vector3<f64>]) -> f64 {
 }
 
 fn max_diff(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max)
 }
 
 /// Hasimoto: a sphere's self-mobility in a cubic box is (1 − 2.837297 a/L + (4π/3)(a/L)³) of
@@ -105,8 +113,12 @@ fn a_pair_deep_inside_a_growing_box_tends_to_open_space() {
             s.set_box(Some([l; 3])).unwrap();
         }
         s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
-        s.add(d, Vector3::new(0.0, 3.0 * d.ell, 0.0), Vector3::new(1.0, 1.0, 0.0))
-            .unwrap();
+        s.add(
+            d,
+            Vector3::new(0.0, 3.0 * d.ell, 0.0),
+            Vector3::new(1.0, 1.0, 0.0),
+        )
+        .unwrap();
         s
     };
     let f = [
@@ -122,11 +134,17 @@ fn a_pair_deep_inside_a_growing_box_tends_to_open_space() {
         let v = build(Some(l)).sphere_velocities(&f).unwrap();
         let diff = max_diff(&v, &open) / max_norm(&open);
         if k > 0 {
-            assert!(last / diff > 6.0, "L = {l:e}: difference {diff:e}, before {last:e}");
+            assert!(
+                last / diff > 6.0,
+                "L = {l:e}: difference {diff:e}, before {last:e}"
+            );
         }
         last = diff;
     }
-    assert!(last < 1e-5, "at L = 160 ell the box still changes the velocities by {last:e}");
+    assert!(
+        last < 1e-5,
+        "at L = 160 ell the box still changes the velocities by {last:e}"
+    );
 }
 
 /// The result does not depend on the splitting parameter ξ: three splittings from ξL = 1 to 8 on
@@ -136,7 +154,10 @@ fn a_pair_deep_inside_a_growing_box_tends_to_open_space() {
 #[test]
 fn the_sum_does_not_depend_on_the_splitting() {
     let mut rng = Rng(0x2545f4914f6cdd1d);
-    for (trial, mobility) in [Mobility::Rpy, Mobility::Oseen, Mobility::Rpy].into_iter().enumerate() {
+    for (trial, mobility) in [Mobility::Rpy, Mobility::Oseen, Mobility::Rpy]
+        .into_iter()
+        .enumerate()
+    {
         let b = PeriodicBox::new([30e-6, 40e-6, 35e-6]).unwrap();
         let (pos, radii, f) = random_spheres(&mut rng, 12, &b);
         let at = |xi: f64| {
@@ -147,7 +168,10 @@ fn the_sum_does_not_depend_on_the_splitting() {
         for xi in [3.0, 8.0] {
             let u = at(xi);
             let err = max_diff(&u, &reference) / max_norm(&reference);
-            assert!(err < 1e-10, "trial {trial} ({mobility:?}), xi L = {xi}: {err:e}");
+            assert!(
+                err < 1e-10,
+                "trial {trial} ({mobility:?}), xi L = {xi}: {err:e}"
+            );
         }
     }
 }
@@ -189,7 +213,10 @@ fn the_periodic_mobility_is_symmetric_positive_definite() {
         assert!(asym < 1e-12, "trial {trial}: asymmetry {asym:e}");
         let eig = m.clone().symmetric_eigen().eigenvalues;
         let (lo, hi) = (eig.min(), eig.max());
-        assert!(lo > 1e-3 * hi, "trial {trial}: eigenvalues from {lo:e} to {hi:e}");
+        assert!(
+            lo > 1e-3 * hi,
+            "trial {trial}: eigenvalues from {lo:e} to {hi:e}"
+        );
         // M·F minus the drag is the matrix-free product.
         let flat = DVector::from_iterator(3 * f.len(), f.iter().flat_map(|v| [v.x, v.y, v.z]));
         let mf = &m * flat;
@@ -197,7 +224,10 @@ fn the_periodic_mobility_is_symmetric_positive_definite() {
         for (i, ui) in u.iter().enumerate() {
             let drag = f[i] / (6.0 * std::f64::consts::PI * MU * radii[i]);
             let dense = Vector3::new(mf[3 * i], mf[3 * i + 1], mf[3 * i + 2]) - drag;
-            assert!((dense - ui).norm() < 1e-11 * max_norm(&u), "trial {trial}, sphere {i}");
+            assert!(
+                (dense - ui).norm() < 1e-11 * max_norm(&u),
+                "trial {trial}, sphere {i}"
+            );
         }
     }
 }
@@ -217,16 +247,28 @@ fn pairs_across_a_face_meet_by_their_minimum_image() {
     let b = Vector3::new(-0.47 * l, 0.12 * l, 0.01 * l);
     let n = Vector3::new(1.0, 0.3, 0.1);
     boxed.add(d, a, n).unwrap();
-    boxed.add(Dumbbell { phase: 1.0, ..d }, b, Vector3::y()).unwrap();
-    open.add(d, a, n).unwrap();
-    open.add(Dumbbell { phase: 1.0, ..d }, b + Vector3::new(l, 0.0, 0.0), Vector3::y())
+    boxed
+        .add(Dumbbell { phase: 1.0, ..d }, b, Vector3::y())
         .unwrap();
+    open.add(d, a, n).unwrap();
+    open.add(
+        Dumbbell { phase: 1.0, ..d },
+        b + Vector3::new(l, 0.0, 0.0),
+        Vector3::y(),
+    )
+    .unwrap();
     for i in 0..2 {
         let (vb, wb) = boxed.rates(i).unwrap();
         let (vo, wo) = open.rates(i).unwrap();
         assert!(vo.norm() > 0.0);
-        assert!((vb - vo).norm() <= 1e-12 * vo.norm(), "swimmer {i}: {vb} vs {vo}");
-        assert!((wb - wo).norm() <= 1e-12 * wo.norm(), "swimmer {i}: {wb} vs {wo}");
+        assert!(
+            (vb - vo).norm() <= 1e-12 * vo.norm(),
+            "swimmer {i}: {vb} vs {vo}"
+        );
+        assert!(
+            (wb - wo).norm() <= 1e-12 * wo.norm(),
+            "swimmer {i}: {wb} vs {wo}"
+        );
     }
 }
 
@@ -243,7 +285,10 @@ fn a_box_limits_the_cutoff_and_stays_on_the_cpu() {
     assert_eq!(s.averaged_cutoff().unwrap(), Some(0.5 * l));
     s.set_cutoff(Some(0.6 * l)).unwrap();
     let e = s.averaged_cutoff().unwrap_err().to_string();
-    assert!(e.contains("half the box") && e.contains("s.cutoff ="), "{e}");
+    assert!(
+        e.contains("half the box") && e.contains("s.cutoff ="),
+        "{e}"
+    );
     s.set_cutoff(None).unwrap();
     s.set_backend(Backend::Gpu);
     let e = swimlab::engine::plan::plan(&s).unwrap_err().to_string();
@@ -257,13 +302,18 @@ fn box_settings_are_checked_and_saved() {
     let d = Dumbbell::default();
     let mut s = Scene::new();
     s.add(d, Vector3::new(0.0, 0.0, 0.0), Vector3::x()).unwrap();
-    s.add(d, Vector3::new(0.0, 6.0 * d.ell, 0.0), Vector3::x()).unwrap();
+    s.add(d, Vector3::new(0.0, 6.0 * d.ell, 0.0), Vector3::x())
+        .unwrap();
     let e = s.set_box(Some([2.0 * d.ell; 3])).unwrap_err().to_string();
     assert!(e.contains("too short") && e.contains("longer than"), "{e}");
-    let e = s.set_box(Some([6.0 * d.ell + 1e-7; 3])).unwrap_err().to_string();
+    let e = s
+        .set_box(Some([6.0 * d.ell + 1e-7; 3]))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("overlap the image"), "{e}");
     assert!(s.periodic().is_none());
-    s.set_box(Some([20.0 * d.ell, 30.0 * d.ell, 25.0 * d.ell])).unwrap();
+    s.set_box(Some([20.0 * d.ell, 30.0 * d.ell, 25.0 * d.ell]))
+        .unwrap();
     s.set_ewald_tol(1e-9).unwrap();
     let back = Scene::from_json(&s.to_json().unwrap()).unwrap();
     assert_eq!(back.periodic(), s.periodic());
@@ -278,9 +328,14 @@ fn a_microscopic_pair_runs_in_a_box() {
     let d = Dumbbell::default();
     let mut s = Scene::new();
     s.set_box(Some([10.0 * d.ell; 3])).unwrap();
-    s.add(d, Vector3::new(-0.25 * d.ell, 0.0, 0.0), Vector3::x()).unwrap();
-    s.add(Dumbbell { phase: 0.8, ..d }, Vector3::new(0.0, 2.5 * d.ell, 0.0), Vector3::x())
+    s.add(d, Vector3::new(-0.25 * d.ell, 0.0, 0.0), Vector3::x())
         .unwrap();
+    s.add(
+        Dumbbell { phase: 0.8, ..d },
+        Vector3::new(0.0, 2.5 * d.ell, 0.0),
+        Vector3::x(),
+    )
+    .unwrap();
     // Rates: dR_H/dt = w1 v1 + w2 v2 for the spring forces ±f.
     let (rate, _) = s.rates(0).unwrap();
     let mut f = Vec::new();
@@ -293,7 +348,10 @@ fn a_microscopic_pair_runs_in_a_box() {
     }
     let v = s.sphere_velocities(&f).unwrap();
     let want = d.w1() * v[0] + d.w2() * v[1];
-    assert!((rate - want).norm() < 1e-9 * want.norm().max(1e-30), "{rate} vs {want}");
+    assert!(
+        (rate - want).norm() < 1e-9 * want.norm().max(1e-30),
+        "{rate} vs {want}"
+    );
     let mut sim = swimlab::engine::Simulation::new(s);
     sim.run_periods(1.0).unwrap();
     assert!(sim.scene().displacement(0).unwrap().norm() > 0.0);

@@ -231,3 +231,77 @@ fn kill_9_keeps_every_frame_already_written() {
         "{frames} frames after the kill, {seen} seen before"
     );
 }
+
+/// In a periodic box the frames carry the box as their cell (pbc true, origin at −L/2) and the
+/// swimmers moved with their R_H into the box; ASE reads both.
+#[test]
+fn ase_reads_a_periodic_box() {
+    let Some(python) = python_with_ase() else {
+        return;
+    };
+    let d = dir("ase-box");
+    let path = d.join("box.xyz");
+    let mut s = Scene::new();
+    s.set_model(swimlab::engine::Model::Averaged);
+    let l = 100e-6;
+    s.set_box(Some([l, 1.2 * l, 0.8 * l])).unwrap();
+    let dd = swimlab::engine::Dumbbell::default();
+    // Centres outside the box: shown at their images inside.
+    s.add(
+        dd,
+        nalgebra::Vector3::new(0.9 * l, 0.0, 0.0),
+        nalgebra::Vector3::x(),
+    )
+    .unwrap();
+    s.add(
+        dd,
+        nalgebra::Vector3::new(0.0, -0.7 * l, 0.1 * l),
+        nalgebra::Vector3::y(),
+    )
+    .unwrap();
+    let mut sim = Simulation::new(s);
+    sim.trajectory(&path, Trigger::EveryPeriods(1.0)).unwrap();
+    sim.run_periods(1.0).unwrap();
+    let out = Command::new(python)
+        .args([
+            "-c",
+            "import ase.io, json, sys\n\
+             f = ase.io.read(sys.argv[1], index=-1)\n\
+             print(json.dumps({'cell': f.cell.lengths().tolist(), 'pbc': f.pbc.tolist(), 'pos': f.positions.tolist()}))",
+            path.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "ASE failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let cell: Vec<f64> = v["cell"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(cell, vec![100.0, 120.0, 80.0]);
+    assert_eq!(v["pbc"], serde_json::json!([true, true, true]));
+    let scene = sim.into_scene();
+    for i in 0..2 {
+        let c = scene.shown(scene.center(i).unwrap()) * 1e6;
+        let (x1, x2) = (&v["pos"][2 * i], &v["pos"][2 * i + 1]);
+        for k in 0..3 {
+            let mid = (x1[k].as_f64().unwrap() * dd.a1 + x2[k].as_f64().unwrap() * dd.a2)
+                / (dd.a1 + dd.a2);
+            assert!(
+                (mid - c[k]).abs() < 1e-9,
+                "swimmer {i}: R_H {mid} shown at {}",
+                c[k]
+            );
+            assert!(
+                c[k].abs() <= 0.5 * cell[k],
+                "swimmer {i} shown outside the box"
+            );
+        }
+    }
+}

@@ -82,7 +82,11 @@ impl SoaSpheres {
     /// x_i − x_j as (x, y, z), its minimum image in a box.
     #[inline]
     fn delta(&self, i: usize, j: usize) -> (f64, f64, f64) {
-        let (rx, ry, rz) = (self.x[i] - self.x[j], self.y[i] - self.y[j], self.z[i] - self.z[j]);
+        let (rx, ry, rz) = (
+            self.x[i] - self.x[j],
+            self.y[i] - self.y[j],
+            self.z[i] - self.z[j],
+        );
         match &self.periodic {
             None => (rx, ry, rz),
             Some(b) => (b.image(rx, 0), b.image(ry, 1), b.image(rz, 2)),
@@ -368,8 +372,13 @@ fn closest_in_cells(
     keep: impl Fn(f64) -> bool + Sync,
 ) -> Option<(f64, usize, usize)> {
     let n = s.len();
-    let grid =
-        super::cells::CellGrid::build_in(&s.x[..n], &s.y[..n], &s.z[..n], side, s.periodic.as_ref());
+    let grid = super::cells::CellGrid::build_in(
+        &s.x[..n],
+        &s.y[..n],
+        &s.z[..n],
+        side,
+        s.periodic.as_ref(),
+    );
     let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
         if (b.0, b.1, b.2) < (a.0, a.1, a.2) {
             b

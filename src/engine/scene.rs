@@ -9,13 +9,13 @@
 use super::averaged::AveragedSystem;
 use super::backend::Backend;
 use super::contacts::{Contacts, Overlaps, Steric};
-use super::ewald::{Ewald, DEFAULT_EWALD_TOL};
-use super::periodic::{separation, PeriodicBox};
 use super::error::{invalid, require_finite, require_positive, unsupported, Result, Setting};
+use super::ewald::{Ewald, DEFAULT_EWALD_TOL};
 use super::integrators::{IntegratorSpec, OdeSystem, Stats};
 use super::micro::MicroSystem;
 use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
+use super::periodic::{separation, PeriodicBox};
 use super::rigid::RigidSystem;
 use super::swimmer::{unit_direction, Dumbbell};
 use super::thermal::{NoiseRoot, Thermal};
@@ -110,7 +110,10 @@ pub struct Scene {
     #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
     periodic: Option<PeriodicBox>,
     /// Tolerance of the box's Ewald sums (saved only when not the default).
-    #[serde(default = "default_ewald_tol", skip_serializing_if = "is_default_ewald_tol")]
+    #[serde(
+        default = "default_ewald_tol",
+        skip_serializing_if = "is_default_ewald_tol"
+    )]
     ewald_tol: f64,
 }
 
@@ -373,7 +376,16 @@ impl Scene {
     /// The box's periodic mobility for the sphere models (`None` in open space).
     pub(crate) fn ewald(&self) -> Result<Option<Ewald>> {
         self.periodic
-            .map(|b| Ewald::new(b, self.mu, self.mobility, 2 * self.count(), self.ewald_tol, None))
+            .map(|b| {
+                Ewald::new(
+                    b,
+                    self.mu,
+                    self.mobility,
+                    2 * self.count(),
+                    self.ewald_tol,
+                    None,
+                )
+            })
             .transpose()
     }
 
@@ -733,6 +745,15 @@ impl Scene {
             Model::Micro => (rh - d.w2() * v, rh + d.w1() * v),
             Model::Averaged | Model::Rigid => d.sphere_positions(rh, v, self.contact_length(d)),
         }
+    }
+
+    /// Sphere centres of swimmer `i` as shown (snapshots, trajectories): in a box moved with its
+    /// R_H into the box, the swimmer kept whole (its spheres may reach over a face).
+    pub fn shown_spheres(&self, i: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let (x1, x2) = self.spheres(i);
+        let rh = self.base[i] + vec3(&self.state, STATE_PER_SWIMMER * i);
+        let shift = self.shown(rh) - rh;
+        (x1 + shift, x2 + shift)
     }
 
     /// The shortest stroke period of the swimmers (s); infinite without swimmers.

@@ -4,10 +4,10 @@
 
 use super::contacts::Contacts;
 use super::ewald::Ewald;
-use super::periodic::{separation, PeriodicBox};
 use super::integrators::Problem;
 use super::mobility::{self_mobility, Mobility};
 use super::pairs::{self, SoaSpheres};
+use super::periodic::{separation, PeriodicBox};
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
 

@@ -138,6 +138,8 @@ fn xml_escape(s: &str) -> String {
 
 /// The spheres of a scene as a frame: positions and radii in µm, swimmer, sphere (1 or 2), N.
 struct Spheres {
+    /// The periodic box's sides (µm), if any.
+    cell: Option<[f64; 3]>,
     pos: Vec<[f64; 3]>,
     radius: Vec<f64>,
     swimmer: Vec<i32>,
@@ -149,6 +151,7 @@ impl Spheres {
     fn of(scene: &Scene) -> Self {
         let n = 2 * scene.count();
         let mut s = Spheres {
+            cell: scene.periodic().map(|b| b.sides().map(|l| l * UM)),
             pos: Vec::with_capacity(n),
             radius: Vec::with_capacity(n),
             swimmer: Vec::with_capacity(n),
@@ -156,7 +159,7 @@ impl Spheres {
             dir: Vec::with_capacity(n),
         };
         for (i, d) in scene.swimmers().iter().enumerate() {
-            let (x1, x2) = scene.spheres(i);
+            let (x1, x2) = scene.shown_spheres(i);
             let dir = (x2 - x1).normalize();
             for (k, (x, a)) in [(x1, d.a1), (x2, d.a2)].into_iter().enumerate() {
                 s.pos.push([x.x * UM, x.y * UM, x.z * UM]);
@@ -173,9 +176,19 @@ impl Spheres {
     fn xyz(&self, time: f64) -> String {
         let mut out = String::with_capacity(64 + 120 * self.pos.len());
         let _ = writeln!(out, "{}", self.pos.len());
+        // A periodic box as the frame's cell (the box spans −L/2 … L/2 about the origin).
+        let cell = match self.cell {
+            Some([x, y, z]) => format!(
+                "Lattice=\"{x:?} 0.0 0.0 0.0 {y:?} 0.0 0.0 0.0 {z:?}\" Origin=\"{:?} {:?} {:?}\" pbc=\"T T T\"",
+                -0.5 * x,
+                -0.5 * y,
+                -0.5 * z
+            ),
+            None => "pbc=\"F F F\"".to_string(),
+        };
         let _ = writeln!(
             out,
-            "Properties=species:S:1:pos:R:3:radius:R:1:swimmer:I:1:sphere:I:1:N:R:3 Time={time:?} time_unit=s length_unit=um pbc=\"F F F\""
+            "{cell} Properties=species:S:1:pos:R:3:radius:R:1:swimmer:I:1:sphere:I:1:N:R:3 Time={time:?} time_unit=s length_unit=um"
         );
         for k in 0..self.pos.len() {
             let (p, d) = (self.pos[k], self.dir[k]);

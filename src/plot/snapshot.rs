@@ -159,14 +159,14 @@ fn picture<'a>(scene: &Scene, opts: &'a SnapshotOptions) -> Result<ScenePicture<
     let um = 1e6;
     let mut order: Vec<usize> = (0..scene.count()).collect();
     let depth_of = |i: usize| {
-        let (p, q) = scene.spheres(i);
+        let (p, q) = scene.shown_spheres(i);
         (p[depth] + q[depth]) / 2.0
     };
     order.sort_by(|&i, &j| depth_of(i).total_cmp(&depth_of(j)));
     let mut discs = Vec::with_capacity(2 * scene.count());
     let mut rods = Vec::with_capacity(scene.count());
     for i in order {
-        let (p1, p2) = scene.spheres(i);
+        let (p1, p2) = scene.shown_spheres(i);
         let d = &scene.swimmers()[i];
         let n = scene.dir(i).map_err(|e| e.to_string())?;
         let hue = (n[b].atan2(n[a]) / (2.0 * std::f64::consts::PI)).rem_euclid(1.0);

@@ -279,9 +279,12 @@ pub fn register(engine: &mut Engine) {
     );
     engine.register_fn(
         "add_random",
-        |s: &mut SceneHandle, d: DumbbellSpec, n: INT, seed: INT, opts: rhai::Map| -> ScriptResult<INT> {
-            add_random(s, d, n, &Dynamic::UNIT, seed, &opts)
-        },
+        |s: &mut SceneHandle,
+         d: DumbbellSpec,
+         n: INT,
+         seed: INT,
+         opts: rhai::Map|
+         -> ScriptResult<INT> { add_random(s, d, n, &Dynamic::UNIT, seed, &opts) },
     );
 
     engine.register_fn(

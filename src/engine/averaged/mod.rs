@@ -601,7 +601,13 @@ impl OdeSystem for AveragedSystem {
             self.steric_f.fill(Vector3::zeros());
             let parallel = self.coef.len() >= PARALLEL_SWIMMERS;
             let periodic = self.periodic.as_ref();
-            st.add_forces(&self.sphere_pos, &self.radii, periodic, &mut self.steric_f, parallel);
+            st.add_forces(
+                &self.sphere_pos,
+                &self.radii,
+                periodic,
+                &mut self.steric_f,
+                parallel,
+            );
         }
         self.rows_into(y, dy);
     }
