@@ -15,6 +15,7 @@ pub mod choice;
 pub mod contacts;
 pub mod error;
 pub mod ewald;
+pub mod fields;
 pub mod files;
 pub mod gpu;
 pub mod integrators;

@@ -3,6 +3,8 @@
 
 use super::advance::Probe;
 use super::error::Result;
+use super::fields::{Field, FieldKind, FieldSpec, FieldStat};
+use super::periodic::separation;
 use super::scene::Scene;
 use super::stepping::{RunControl, Workspace};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
@@ -27,7 +29,7 @@ pub enum Observable {
     PairSeparation(usize, usize, Vector3<f64>),
     /// q = N^i · N^j.
     Q(usize, usize),
-    /// D_H = |R_H^i − R_H^j| (m).
+    /// D_H = |R_H^i − R_H^j| (m), by minimum image in a box.
     DistanceH(usize, usize),
     /// Δq(T) = q(0) − q(T) over the next period (a probe run on a copy of the scene).
     DeltaQ(usize, usize),
@@ -55,6 +57,16 @@ pub enum Observable {
         bins: usize,
         /// Upper end of the last bin (m).
         r_max: f64,
+    },
+    /// A scalar summary of a field's cells ([`super::fields`]): of ρ (1/m³), |Π| or Q's largest
+    /// eigenvalue.
+    Field {
+        /// Which field.
+        kind: FieldKind,
+        /// Which summary.
+        stat: FieldStat,
+        /// Its grid and smoothing.
+        spec: FieldSpec,
     },
 }
 
@@ -90,6 +102,7 @@ impl Observable {
             Observable::Msd => "msd".into(),
             Observable::Peclet(i, j) => format!("Pe[{i},{j}]"),
             Observable::PairDistances { .. } => "D_H_hist".into(),
+            Observable::Field { kind, stat, .. } => format!("{}_{}", kind.name(), stat.name()),
         }
     }
 
@@ -107,6 +120,15 @@ impl Observable {
             Observable::MeanSpeed => "m/s",
             Observable::Msd => "m^2",
             Observable::PairDistances { .. } => "pairs",
+            Observable::Field {
+                kind: FieldKind::Density,
+                stat: FieldStat::Variance,
+                ..
+            } => "1/m^6",
+            Observable::Field {
+                kind: FieldKind::Density,
+                ..
+            } => "1/m^3",
             Observable::DeltaDistanceH(..) => "ell",
             _ => "1",
         }
@@ -152,12 +174,16 @@ impl Observable {
             | Observable::Nematic
             | Observable::MinGap
             | Observable::MeanSpeed
-            | Observable::PairDistances { .. } => vec![],
+            | Observable::PairDistances { .. }
+            | Observable::Field { .. } => vec![],
         }
     }
 
     /// Check that the indices exist in `scene` and the parameters make sense.
     pub fn check(&self, scene: &Scene) -> Result<()> {
+        if let Observable::Field { spec, .. } = self {
+            spec.check()?;
+        }
         if let Observable::PairDistances { bins, r_max } = *self {
             if bins == 0 || bins > MAX_BINS || !(r_max.is_finite() && r_max > 0.0) {
                 return Err(super::error::invalid!(
@@ -204,7 +230,9 @@ impl Observable {
                 vec![(s.center(j)? - s.center(i)?).dot(&axis)]
             }
             Observable::Q(i, j) => vec![s.dir(i)?.dot(&s.dir(j)?)],
-            Observable::DistanceH(i, j) => vec![(s.center(i)? - s.center(j)?).norm()],
+            Observable::DistanceH(i, j) => {
+                vec![separation(s.periodic(), s.center(i)? - s.center(j)?).norm()]
+            }
             Observable::DeltaQ(i, j) => {
                 let q = Observable::Q(i, j);
                 let (before, after) = Self::over_a_period(s, &q, probe)?;
@@ -240,6 +268,7 @@ impl Observable {
                 vec![v.iter().map(|v| v.norm()).sum::<f64>() / v.len().max(1) as f64]
             }
             Observable::PairDistances { bins, r_max } => Self::histogram(s, bins, r_max)?,
+            Observable::Field { kind, stat, spec } => vec![Field::of(s, kind, &spec)?.stat(stat)],
             Observable::Msd => {
                 let mut sum = 0.0;
                 for i in 0..s.count() {
@@ -283,10 +312,11 @@ impl Observable {
             .map(|i| s.center(i))
             .collect::<Result<Vec<_>>>()?;
         let width = r_max / bins as f64;
+        let periodic = s.periodic();
         let row = |i: usize| {
             let mut h = vec![0.0; bins];
             for cj in &c[i + 1..] {
-                let k = ((c[i] - cj).norm() / width) as usize;
+                let k = (separation(periodic, c[i] - cj).norm() / width) as usize;
                 if k < bins {
                     h[k] += 1.0;
                 }

@@ -6,10 +6,12 @@
 //! plotters, headless: text is set in an embedded subset of DejaVu Sans, so no system font is
 //! needed.
 
+mod heatmap;
 mod render;
 mod snapshot;
 mod text;
 
+pub use heatmap::HeatMap;
 pub use snapshot::{scene_image, snapshot, Plane, SceneFilm, SnapshotOptions};
 
 /// A picture drawn in memory (for notebooks): PNG bytes and SVG text of the same drawing.

@@ -10,7 +10,7 @@ use std::path::Path;
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
 
 /// Register the embedded font as "sans-serif" once per process.
-fn register_font() {
+pub(super) fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // The bytes are a valid font (checked by the picture tests); a failure would only leave
@@ -21,7 +21,7 @@ fn register_font() {
 
 /// A drawing error as a message: a backend (file) error names the cause and the fix; anything
 /// else is plotters' own text.
-fn err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
+pub(super) fn err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
     match e {
         DrawingAreaErrorKind::BackendError(inner) => {
             let text = inner.to_string();
@@ -46,6 +46,28 @@ pub(super) fn figure(f: &Figure, path: &Path, format: Format) -> Result<(), Stri
         Format::Png => {
             let root = BitMapBackend::new(path, (f.width, f.height)).into_drawing_area();
             draw_figure(f, &root)?;
+            root.present().map_err(err)
+        }
+    }
+}
+
+/// Draw `picture` of `size` to `path` in `format`.
+pub(super) fn to_file(
+    size: (u32, u32),
+    picture: &dyn Drawable,
+    path: &Path,
+    format: Format,
+) -> Result<(), String> {
+    register_font();
+    match format {
+        Format::Svg => {
+            let root = SVGBackend::new(path, size).into_drawing_area();
+            picture.draw_svg(&root)?;
+            root.present().map_err(err)
+        }
+        Format::Png => {
+            let root = BitMapBackend::new(path, size).into_drawing_area();
+            picture.draw_bitmap(&root)?;
             root.present().map_err(err)
         }
     }

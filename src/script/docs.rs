@@ -58,6 +58,7 @@ pub static DOCS: LazyLock<Vec<Doc>> = LazyLock::new(|| {
         super::sweep_api::DOCS,
         super::plot_api::DOCS,
         super::picture_api::DOCS,
+        super::field_api::DOCS,
         super::integrator_api::DOCS,
         super::observable_api::DOCS,
         super::params::DOCS,

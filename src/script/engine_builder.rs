@@ -1,7 +1,7 @@
 //! The one place a Rhai engine is built and scripts are run.
 
 use super::{
-    csv_api, dumbbell_api, float_cmp, integrator_api, interrupt, limits, observable_api,
+    csv_api, dumbbell_api, field_api, float_cmp, integrator_api, interrupt, limits, observable_api,
     panic_guard::guard, params, picture_api, plot_api, render_error, scene_api, stdlib, sweep_api,
     util_api,
 };
@@ -32,6 +32,7 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     sweep_api::register(&mut engine);
     plot_api::register(&mut engine);
     picture_api::register(&mut engine);
+    field_api::register(&mut engine);
     params::register_defaults(&mut engine);
     let embedded = stdlib::install(&mut engine);
     // Ctrl-C also stops plain script loops between statements.

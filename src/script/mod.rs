@@ -7,6 +7,7 @@ mod csv_api;
 pub mod docs;
 mod dumbbell_api;
 mod engine_builder;
+mod field_api;
 pub mod figures;
 mod float_cmp;
 mod integrator_api;

@@ -31,7 +31,7 @@ impl Picture {
     }
 
     /// Write the picture to `path`: PNG or SVG by the extension, whole or not at all.
-    fn save(&self, path: &str) -> ScriptResult<()> {
+    pub(crate) fn save(&self, path: &str) -> ScriptResult<()> {
         let p = std::path::Path::new(path);
         let format = crate::plot::Format::of(p).map_err(script_error)?;
         let bytes: &[u8] = match format {

@@ -1,0 +1,606 @@
+//! Continuum fields of a suspension on a grid: the number density ρ, the polarization Π and the
+//! nematic tensor Q of the swimmers' hydrodynamic centres, smoothed by a Gaussian kernel; and the
+//! structure factor S(k) of the centres in a periodic box.
+//!
+//! Each swimmer σ spreads its weight over the grid cells within 4 widths of R_H^σ (by minimum
+//! image in a box, the kernel then periodic) as e^{−|x − R_H|²/2w²}, normalised on the grid so
+//! that Σ_cells ρ ΔV counts it exactly once:
+//! ρ(x) = Σ_σ K_σ(x), Π(x) = Σ_σ N^σ K_σ(x)/ρ(x), Q(x) = Σ_σ (3N^σN^σ − I)/2 K_σ(x)/ρ(x)
+//! (Π and Q are the local averages of N and of the swimmers' nematic tensor: |Π| = 1 and the
+//! largest eigenvalue of Q is 1 where all swimmers are aligned; both 0 where ρ = 0).
+
+use super::choice::{self, Choice, Named};
+use super::error::{invalid, Result};
+use super::scene::Scene;
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Which field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FieldKind {
+    /// Number density ρ of the hydrodynamic centres (1/m³).
+    Density,
+    /// Polarization Π: the local mean orientation (dimensionless vector).
+    Polarization,
+    /// Nematic tensor Q = ⟨(3NN − I)/2⟩ locally (dimensionless, symmetric, traceless).
+    Nematic,
+}
+
+impl Named for FieldKind {
+    const KIND: &'static str = "field";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: FieldKind::Density,
+            name: "density",
+            about: "number density of the centres, 1/m^3",
+        },
+        Choice {
+            value: FieldKind::Polarization,
+            name: "polarization",
+            about: "local mean orientation, a vector",
+        },
+        Choice {
+            value: FieldKind::Nematic,
+            name: "nematic",
+            about: "local nematic tensor (3NN - I)/2, 3x3",
+        },
+    ];
+}
+
+choice::inherent_names!(FieldKind);
+
+impl FieldKind {
+    /// Values per cell: 1, 3 or 9 (Q row by row).
+    pub fn components(self) -> usize {
+        match self {
+            FieldKind::Density => 1,
+            FieldKind::Polarization => 3,
+            FieldKind::Nematic => 9,
+        }
+    }
+}
+
+/// The most cells a field may have (64 MB of f64 for a nematic field).
+pub const MAX_CELLS: usize = 1 << 20;
+
+/// Grid and smoothing of a field.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FieldSpec {
+    /// Cells per axis.
+    pub grid: [usize; 3],
+    /// Width w of the Gaussian kernel (m); `None`: the largest cell side.
+    pub width: Option<f64>,
+}
+
+impl Default for FieldSpec {
+    fn default() -> Self {
+        FieldSpec {
+            grid: [32, 32, 32],
+            width: None,
+        }
+    }
+}
+
+impl FieldSpec {
+    /// Check the grid and width.
+    pub fn check(&self) -> Result<()> {
+        let cells: usize = self.grid.iter().product();
+        if self.grid.contains(&0) || cells > MAX_CELLS {
+            return Err(invalid!(
+                "a field grid needs 1 or more cells per axis and at most {MAX_CELLS} cells in all, got {:?}; e.g. grid: [32, 32, 32]",
+                self.grid
+            ));
+        }
+        if let Some(w) = self.width {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(invalid!(
+                    "a field's smoothing width must be a positive length in m, got {w}; e.g. width: 10e-6, or leave it out for one cell"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A field on a regular grid; cell (i, j, k) is centred at origin + (i, j, k)·spacing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Field {
+    /// Which field.
+    pub kind: FieldKind,
+    /// Cells per axis.
+    pub grid: [usize; 3],
+    /// Centre of cell (0, 0, 0) (m).
+    pub origin: [f64; 3],
+    /// Cell sides (m).
+    pub spacing: [f64; 3],
+    /// The kernel's width (m).
+    pub width: f64,
+    /// Whether the grid is a periodic box's.
+    pub periodic: bool,
+    /// `kind.components()` values per cell, cells x fastest, then y, then z.
+    pub values: Vec<f64>,
+}
+
+impl Field {
+    /// The field of `kind` of `scene`'s swimmers on the grid of `spec`: in a box the box's cells,
+    /// in open space a grid over the centres' bounding box padded by 4 widths.
+    pub fn of(scene: &Scene, kind: FieldKind, spec: &FieldSpec) -> Result<Field> {
+        spec.check()?;
+        if scene.count() == 0 {
+            return Err(invalid!(
+                "the scene has no swimmers, so no field; add some first"
+            ));
+        }
+        let centres: Vec<Vector3<f64>> = (0..scene.count())
+            .map(|i| scene.center(i).map(|c| scene.shown(c)))
+            .collect::<Result<_>>()?;
+        let dirs: Vec<Vector3<f64>> = (0..scene.count())
+            .map(|i| scene.dir(i))
+            .collect::<Result<_>>()?;
+        let n = spec.grid;
+        let (origin, spacing, width) = match scene.periodic() {
+            Some(b) => {
+                let l = b.sides();
+                let h: [f64; 3] = std::array::from_fn(|d| l[d] / n[d] as f64);
+                let w = spec.width.unwrap_or(h[0].max(h[1]).max(h[2]));
+                (std::array::from_fn(|d| -0.5 * l[d] + 0.5 * h[d]), h, w)
+            }
+            None => {
+                let lo: [f64; 3] = std::array::from_fn(|d| {
+                    centres.iter().map(|c| c[d]).fold(f64::INFINITY, f64::min)
+                });
+                let hi: [f64; 3] = std::array::from_fn(|d| {
+                    centres
+                        .iter()
+                        .map(|c| c[d])
+                        .fold(f64::NEG_INFINITY, f64::max)
+                });
+                let ell = scene.swimmers()[0].ell;
+                let w = spec.width.unwrap_or_else(|| {
+                    let h = (0..3)
+                        .map(|d| (hi[d] - lo[d]) / n[d] as f64)
+                        .fold(0.0, f64::max);
+                    if h > 0.0 {
+                        h
+                    } else {
+                        ell
+                    }
+                });
+                let h: [f64; 3] = std::array::from_fn(|d| (hi[d] - lo[d] + 8.0 * w) / n[d] as f64);
+                (std::array::from_fn(|d| lo[d] - 4.0 * w + 0.5 * h[d]), h, w)
+            }
+        };
+        let mut f = Field {
+            kind,
+            grid: n,
+            origin,
+            spacing,
+            width,
+            periodic: scene.periodic().is_some(),
+            values: vec![0.0; n[0] * n[1] * n[2] * kind.components()],
+        };
+        let sides = scene.periodic().map(|b| b.sides());
+        f.deposit(&centres, &dirs, sides);
+        Ok(f)
+    }
+
+    /// Spread every swimmer's weight and orientation terms over the cells, then divide Π and Q
+    /// by ρ.
+    fn deposit(
+        &mut self,
+        centres: &[Vector3<f64>],
+        dirs: &[Vector3<f64>],
+        sides: Option<[f64; 3]>,
+    ) {
+        let n = self.grid;
+        let comps = self.kind.components();
+        let dv = self.spacing[0] * self.spacing[1] * self.spacing[2];
+        // Per swimmer and axis: the cells within 4 widths and their 1D Gaussian factors (the
+        // kernel is separable), each cell once even where 4 widths exceed half a box.
+        let axis = |c: f64, d: usize| -> Vec<(usize, f64)> {
+            let (h, o, w) = (self.spacing[d], self.origin[d], self.width);
+            let reach = (4.0 * w / h).ceil() as i64;
+            let centre = ((c - o) / h).round() as i64;
+            let (lo, hi) = match sides {
+                Some(_) => {
+                    let half = (n[d] as i64 - 1) / 2;
+                    let m = reach.min(half);
+                    (
+                        centre - m,
+                        centre + m + if n[d] % 2 == 0 && reach > half { 1 } else { 0 },
+                    )
+                }
+                None => (
+                    (centre - reach).max(0),
+                    (centre + reach).min(n[d] as i64 - 1),
+                ),
+            };
+            (lo..=hi)
+                .map(|i| {
+                    let x = o + i as f64 * h;
+                    let dx = match sides {
+                        Some(l) => {
+                            let r = x - c;
+                            r - l[d] * (r / l[d]).round()
+                        }
+                        None => x - c,
+                    };
+                    (
+                        i.rem_euclid(n[d] as i64) as usize,
+                        (-dx * dx / (2.0 * w * w)).exp(),
+                    )
+                })
+                .collect()
+        };
+        let mut rho = vec![0.0; n[0] * n[1] * n[2]];
+        for (c, dir) in centres.iter().zip(dirs) {
+            let (gx, gy, gz) = (axis(c.x, 0), axis(c.y, 1), axis(c.z, 2));
+            let total: f64 = gx.iter().map(|g| g.1).sum::<f64>()
+                * gy.iter().map(|g| g.1).sum::<f64>()
+                * gz.iter().map(|g| g.1).sum::<f64>();
+            let terms: Vec<f64> = match self.kind {
+                FieldKind::Density => vec![],
+                FieldKind::Polarization => vec![dir.x, dir.y, dir.z],
+                FieldKind::Nematic => {
+                    let q: Matrix3<f64> = 1.5 * dir * dir.transpose() - 0.5 * Matrix3::identity();
+                    q.transpose().iter().copied().collect()
+                }
+            };
+            for &(k, fz) in &gz {
+                for &(j, fy) in &gy {
+                    for &(i, fx) in &gx {
+                        let cell = i + n[0] * (j + n[1] * k);
+                        let weight = fx * fy * fz / (total * dv);
+                        rho[cell] += weight;
+                        if comps == 1 {
+                            self.values[cell] += weight;
+                        } else {
+                            for (v, t) in self.values[comps * cell..comps * (cell + 1)]
+                                .iter_mut()
+                                .zip(&terms)
+                            {
+                                *v += weight * t;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if comps > 1 {
+            for (cell, r) in rho.iter().enumerate() {
+                let v = &mut self.values[comps * cell..comps * (cell + 1)];
+                if *r > 0.0 {
+                    v.iter_mut().for_each(|x| *x /= r);
+                } else {
+                    v.fill(0.0);
+                }
+            }
+        }
+    }
+
+    /// The number of cells.
+    pub fn cells(&self) -> usize {
+        self.grid.iter().product()
+    }
+
+    /// The scalar each cell shows: ρ (1/m³), |Π|, or Q's largest eigenvalue S.
+    pub fn scalar(&self, cell: usize) -> f64 {
+        let c = self.kind.components();
+        let v = &self.values[c * cell..c * (cell + 1)];
+        match self.kind {
+            FieldKind::Density => v[0],
+            FieldKind::Polarization => (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt(),
+            FieldKind::Nematic => {
+                let q = Matrix3::from_row_slice(v);
+                SymmetricEigen::new(q).eigenvalues.max()
+            }
+        }
+    }
+
+    /// Σ_cells ρ ΔV for a density field: the number of swimmers.
+    pub fn integral(&self) -> f64 {
+        let dv = self.spacing[0] * self.spacing[1] * self.spacing[2];
+        (0..self.cells()).map(|c| self.scalar(c)).sum::<f64>() * dv
+    }
+
+    /// The cell scalars' summary `stat`.
+    pub fn stat(&self, stat: FieldStat) -> f64 {
+        let n = self.cells() as f64;
+        let values = (0..self.cells()).map(|c| self.scalar(c));
+        match stat {
+            FieldStat::Mean => values.sum::<f64>() / n,
+            FieldStat::Variance => {
+                let all: Vec<f64> = values.collect();
+                let mean = all.iter().sum::<f64>() / n;
+                all.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n
+            }
+            FieldStat::Max => values.fold(f64::NEG_INFINITY, f64::max),
+            FieldStat::Min => values.fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// The 2D slice of cell scalars at `index` across `axis` (0, 1, 2): rows along the next axis,
+    /// columns along the one after (for z: x across, y up), with their extents (m).
+    pub fn slice(&self, axis: usize, index: usize) -> Result<Slice> {
+        if axis > 2 || index >= self.grid[axis] {
+            return Err(invalid!(
+                "the slice index {index} is outside the field's {} cells along {}; use 0 to {}",
+                self.grid.get(axis).copied().unwrap_or(0),
+                ["x", "y", "z"].get(axis).unwrap_or(&"?"),
+                self.grid.get(axis).copied().unwrap_or(1).saturating_sub(1)
+            ));
+        }
+        let (a, b) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let n = self.grid;
+        let mut values = vec![0.0; n[a] * n[b]];
+        for j in 0..n[b] {
+            for i in 0..n[a] {
+                let mut idx = [0; 3];
+                idx[axis] = index;
+                idx[a] = i;
+                idx[b] = j;
+                values[i + n[a] * j] = self.scalar(idx[0] + n[0] * (idx[1] + n[1] * idx[2]));
+            }
+        }
+        let lo = |d: usize| self.origin[d] - 0.5 * self.spacing[d];
+        let hi = |d: usize| lo(d) + n[d] as f64 * self.spacing[d];
+        Ok(Slice {
+            axes: (a, b),
+            cols: n[a],
+            rows: n[b],
+            values,
+            x: (lo(a), hi(a)),
+            y: (lo(b), hi(b)),
+        })
+    }
+
+    /// The field as VTK image data (ParaView's `.vti`): lengths in µm like the trajectories,
+    /// values as point data at the cell centres ("density [1/um^3]", "polarization", "Q").
+    pub fn to_vti(&self) -> Result<Vec<u8>> {
+        use vtkio::model::{
+            Attribute, Attributes, ByteOrder, DataArray, DataSet, Extent, ImageDataPiece, Piece,
+            Version, Vtk,
+        };
+        const UM: f64 = 1e6;
+        let n = self.grid;
+        let array = match self.kind {
+            FieldKind::Density => DataArray::scalars("density [1/um^3]", 1).with_data(
+                self.values
+                    .iter()
+                    .map(|v| v / UM.powi(3))
+                    .collect::<Vec<_>>(),
+            ),
+            FieldKind::Polarization => {
+                DataArray::vectors("polarization").with_data(self.values.clone())
+            }
+            FieldKind::Nematic => DataArray::tensors("Q").with_data(self.values.clone()),
+        };
+        let extent = Extent::Ranges([
+            0..=(n[0] as i32 - 1),
+            0..=(n[1] as i32 - 1),
+            0..=(n[2] as i32 - 1),
+        ]);
+        let vtk = Vtk {
+            version: Version::new_xml(1, 0),
+            byte_order: ByteOrder::LittleEndian,
+            title: String::new(),
+            file_path: None,
+            data: DataSet::ImageData {
+                extent: extent.clone(),
+                origin: self.origin.map(|o| (o * UM) as f32),
+                spacing: self.spacing.map(|h| (h * UM) as f32),
+                meta: None,
+                pieces: vec![Piece::Inline(Box::new(ImageDataPiece {
+                    extent,
+                    data: Attributes {
+                        point: vec![Attribute::DataArray(array)],
+                        cell: Vec::new(),
+                    },
+                }))],
+            },
+        };
+        let file = vtkio::xml::VTKFile::try_from(vtk)
+            .map_err(|e| invalid!("cannot make the VTK image: {e}"))?;
+        let mut bytes = Vec::new();
+        file.write(&mut bytes)
+            .map_err(|e| invalid!("cannot write the VTK image: {e}"))?;
+        Ok(bytes)
+    }
+}
+
+/// A 2D slice of a field's cell scalars for a heat map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Slice {
+    /// The field axes across (columns) and up (rows).
+    pub axes: (usize, usize),
+    /// Columns and rows.
+    pub cols: usize,
+    /// Rows.
+    pub rows: usize,
+    /// Row by row from the bottom, `cols` each.
+    pub values: Vec<f64>,
+    /// Extent across (m).
+    pub x: (f64, f64),
+    /// Extent up (m).
+    pub y: (f64, f64),
+}
+
+/// A scalar summary of a field's cells (of ρ, |Π| or Q's largest eigenvalue).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FieldStat {
+    /// The mean over the cells.
+    Mean,
+    /// The variance over the cells.
+    Variance,
+    /// The largest cell value.
+    Max,
+    /// The smallest cell value.
+    Min,
+}
+
+impl Named for FieldStat {
+    const KIND: &'static str = "field summary";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: FieldStat::Mean,
+            name: "mean",
+            about: "mean over the cells",
+        },
+        Choice {
+            value: FieldStat::Variance,
+            name: "variance",
+            about: "variance over the cells",
+        },
+        Choice {
+            value: FieldStat::Max,
+            name: "max",
+            about: "largest cell value",
+        },
+        Choice {
+            value: FieldStat::Min,
+            name: "min",
+            about: "smallest cell value",
+        },
+    ];
+}
+
+choice::inherent_names!(FieldStat);
+
+/// The most wave vectors a structure factor sums over per axis (|n| ≤ this).
+pub const MAX_WAVE_INDEX: usize = 40;
+
+/// The structure factor of the hydrodynamic centres in the scene's periodic box, binned by |k|.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StructureFactor {
+    /// Mean |k| of each non-empty bin (1/m).
+    pub k: Vec<f64>,
+    /// Mean S(k) = |Σ_σ e^{ik·R_σ}|²/N over the bin's wave vectors.
+    pub s: Vec<f64>,
+    /// Wave vectors in each bin (each ±k pair once).
+    pub count: Vec<usize>,
+}
+
+/// S(k) = |Σ_σ e^{ik·R_H^σ}|²/N over the box's wave vectors 0 < |k| ≤ `k_max` (1/m; default
+/// 1.5·2π over the mean spacing (V/N)^{1/3}, at most [`MAX_WAVE_INDEX`] waves per axis), averaged
+/// in `bins` bins of equal width in |k| from 0 to k_max. Box only.
+pub fn structure_factor(scene: &Scene, bins: usize, k_max: Option<f64>) -> Result<StructureFactor> {
+    let Some(b) = scene.periodic() else {
+        return Err(invalid!(
+            "the structure factor needs a periodic box (its wave vectors are the box's); set s.box = [Lx, Ly, Lz] first"
+        ));
+    };
+    if !(1..=10_000).contains(&bins) {
+        return Err(invalid!(
+            "the structure factor takes 1 to 10000 bins, got {bins}; e.g. #{{ bins: 32 }}"
+        ));
+    }
+    let n = scene.count();
+    if n == 0 {
+        return Err(invalid!(
+            "the scene has no swimmers, so no structure factor; add some first"
+        ));
+    }
+    let l = b.sides();
+    let spacing = (b.volume() / n as f64).cbrt();
+    let limit = 2.0 * PI * MAX_WAVE_INDEX as f64 / l[0].max(l[1]).max(l[2]);
+    let k_max = match k_max {
+        Some(k) if k.is_finite() && k > 0.0 => {
+            let top = (0..3)
+                .map(|d| (k * l[d] / (2.0 * PI)).floor() as usize)
+                .max()
+                .unwrap_or(0);
+            if top > MAX_WAVE_INDEX {
+                return Err(invalid!(
+                    "k_max = {k:e} 1/m needs {top} waves per axis in this box, more than {MAX_WAVE_INDEX}; use k_max up to {:e} 1/m",
+                    2.0 * PI * MAX_WAVE_INDEX as f64 / l[0].max(l[1]).max(l[2])
+                ));
+            }
+            k
+        }
+        Some(k) => {
+            return Err(invalid!(
+                "k_max must be a positive wave number in 1/m, got {k}"
+            ))
+        }
+        None => (1.5 * 2.0 * PI / spacing).min(limit),
+    };
+    let m: [i64; 3] = std::array::from_fn(|d| (k_max * l[d] / (2.0 * PI)).floor() as i64);
+    let mut waves = Vec::new();
+    for i in 0..=m[0] {
+        for j in -m[1]..=m[1] {
+            for k in -m[2]..=m[2] {
+                if i == 0 && (j < 0 || (j == 0 && k <= 0)) {
+                    continue;
+                }
+                let kv = Vector3::new(
+                    2.0 * PI * i as f64 / l[0],
+                    2.0 * PI * j as f64 / l[1],
+                    2.0 * PI * k as f64 / l[2],
+                );
+                if kv.norm() <= k_max {
+                    waves.push(([i, j, k], kv.norm()));
+                }
+            }
+        }
+    }
+    // Per centre and axis the powers e^{i 2π n x/L}, n = 0..=m: a wave's phase is three products.
+    let centres: Vec<Vector3<f64>> = (0..n).map(|i| scene.center(i)).collect::<Result<_>>()?;
+    let width = |d: usize| m[d] as usize + 1;
+    let stride = width(0) + width(1) + width(2);
+    let mut table = Vec::with_capacity(n * stride);
+    for c in &centres {
+        for d in 0..3 {
+            let (s1, c1) = (2.0 * PI * c[d] / l[d]).sin_cos();
+            let (mut re, mut im) = (1.0, 0.0);
+            for _ in 0..width(d) {
+                table.push((re, im));
+                (re, im) = (re * c1 - im * s1, re * s1 + im * c1);
+            }
+        }
+    }
+    let s_of = |&(idx, _): &([i64; 3], f64)| {
+        let (mut sr, mut si) = (0.0, 0.0);
+        for p in 0..n {
+            let mut base = p * stride;
+            let (mut re, mut im) = (1.0, 0.0);
+            for d in 0..3 {
+                let (a, bb) = table[base + idx[d].unsigned_abs() as usize];
+                let bb = if idx[d] < 0 { -bb } else { bb };
+                (re, im) = (re * a - im * bb, re * bb + im * a);
+                base += width(d);
+            }
+            sr += re;
+            si += im;
+        }
+        (sr * sr + si * si) / n as f64
+    };
+    let values: Vec<f64> = waves.par_iter().map(s_of).collect();
+    let (mut ks, mut ss, mut counts) = (vec![0.0; bins], vec![0.0; bins], vec![0usize; bins]);
+    for ((_, k), s) in waves.iter().zip(values) {
+        let bin = ((k / k_max * bins as f64) as usize).min(bins - 1);
+        ks[bin] += k;
+        ss[bin] += s;
+        counts[bin] += 1;
+    }
+    let mut out = StructureFactor {
+        k: Vec::new(),
+        s: Vec::new(),
+        count: Vec::new(),
+    };
+    for ((k, s), c) in ks.into_iter().zip(ss).zip(counts) {
+        if c > 0 {
+            out.k.push(k / c as f64);
+            out.s.push(s / c as f64);
+            out.count.push(c);
+        }
+    }
+    Ok(out)
+}
