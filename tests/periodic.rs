@@ -286,7 +286,7 @@ fn a_box_limits_the_cutoff_and_stays_on_the_cpu() {
     s.set_cutoff(Some(0.6 * l)).unwrap();
     let e = s.averaged_cutoff().unwrap_err().to_string();
     assert!(
-        e.contains("half the box") && e.contains("s.cutoff ="),
+        e.contains("half the box") && e.contains("cutoff to"),
         "{e}"
     );
     s.set_cutoff(None).unwrap();

@@ -432,7 +432,7 @@ pub fn check_tol(tol: f64) -> Result<()> {
         Ok(())
     } else {
         Err(invalid!(
-            "the Ewald tolerance must lie between 1e-15 and 1e-2, got {tol}; e.g. s.ewald_tol = 1e-10"
+            "the Ewald tolerance must lie between 1e-15 and 1e-2, got {tol}; e.g. 1e-10"
         ))
     }
 }

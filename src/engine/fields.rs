@@ -494,12 +494,12 @@ pub struct StructureFactor {
 pub fn structure_factor(scene: &Scene, bins: usize, k_max: Option<f64>) -> Result<StructureFactor> {
     let Some(b) = scene.periodic() else {
         return Err(invalid!(
-            "the structure factor needs a periodic box (its wave vectors are the box's); set s.box = [Lx, Ly, Lz] first"
+            "the structure factor needs a periodic box (its wave vectors are the box's); put the scene in a box of sides [Lx, Ly, Lz] first"
         ));
     };
     if !(1..=10_000).contains(&bins) {
         return Err(invalid!(
-            "the structure factor takes 1 to 10000 bins, got {bins}; e.g. #{{ bins: 32 }}"
+            "the structure factor takes 1 to 10000 bins, got {bins}; e.g. 32"
         ));
     }
     let n = scene.count();

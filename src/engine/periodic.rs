@@ -22,7 +22,7 @@ impl PeriodicBox {
         for (k, v) in ["x", "y", "z"].iter().zip(l) {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid!(
-                    "the box side along {k} must be a positive length in m (e.g. s.box = [1e-3, 1e-3, 1e-3]), got {v}; or s.box = () for open space"
+                    "the box side along {k} must be a positive length in m (e.g. 1e-3), got {v}; give three positive sides, or no box for open space"
                 ));
             }
         }

@@ -126,7 +126,7 @@ impl Scene {
             None => Ok(Some(half)),
             Some(c) if c <= half => Ok(Some(c)),
             Some(c) => Err(invalid!(
-                "the averaged model's cutoff {c:e} m is longer than half the box's shortest side ({half:e} m): a pair would meet two images; set s.cutoff = {half:e} or less, or use a larger box"
+                "the averaged model's cutoff {c:e} m is longer than half the box's shortest side ({half:e} m): a pair would meet two images; set the cutoff to {half:e} m or less, or use a larger box"
             )),
         }
     }
