@@ -276,5 +276,8 @@ fn the_structure_factor_needs_a_box() {
     s.add(Dumbbell::default(), Vector3::zeros(), Vector3::x())
         .unwrap();
     let e = structure_factor(&s, 8, None).unwrap_err().to_string();
-    assert!(e.contains("periodic box") && e.contains("box of sides"), "{e}");
+    assert!(
+        e.contains("periodic box") && e.contains("box of sides"),
+        "{e}"
+    );
 }

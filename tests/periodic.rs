@@ -285,10 +285,7 @@ fn a_box_limits_the_cutoff_and_stays_on_the_cpu() {
     assert_eq!(s.averaged_cutoff().unwrap(), Some(0.5 * l));
     s.set_cutoff(Some(0.6 * l)).unwrap();
     let e = s.averaged_cutoff().unwrap_err().to_string();
-    assert!(
-        e.contains("half the box") && e.contains("cutoff to"),
-        "{e}"
-    );
+    assert!(e.contains("half the box") && e.contains("cutoff to"), "{e}");
     s.set_cutoff(None).unwrap();
     s.set_backend(Backend::Gpu);
     let e = swimlab::engine::plan::plan(&s).unwrap_err().to_string();
@@ -355,4 +352,116 @@ fn a_microscopic_pair_runs_in_a_box() {
     let mut sim = swimlab::engine::Simulation::new(s);
     sim.run_periods(1.0).unwrap();
     assert!(sim.scene().displacement(0).unwrap().norm() > 0.0);
+}
+
+/// In a box the cell lists wrap around the faces: the averaged rates through them equal the
+/// all-pairs minimum-image loop's to the rounding of the sums' order (1e-12 of the largest rate),
+/// for cutoffs from a few ℓ to L/2, with and without steric repulsion; the sphere passes (steric
+/// forces, the closest overlap) through periodic cells agree with their all-pairs forms too.
+#[test]
+fn periodic_cell_lists_give_the_all_pairs_rates() {
+    use swimlab::engine::averaged::AveragedSystem;
+    use swimlab::engine::build::{random_suspension, Orientations, Phases};
+    use swimlab::engine::integrators::OdeSystem;
+    use swimlab::engine::Coefficients;
+    let d = Dumbbell {
+        a2: 0.075 * 5e-6,
+        ..Dumbbell::default()
+    };
+    let l = 160e-6;
+    let mut s = Scene::new();
+    s.set_model(Model::Averaged);
+    s.set_box(Some([l, 1.1 * l, 0.9 * l])).unwrap();
+    random_suspension(
+        &mut s,
+        700,
+        d,
+        [l, 1.1 * l, 0.9 * l],
+        Orientations::Random,
+        Phases::Random,
+        21,
+    )
+    .unwrap();
+    let (y, base) = s.raw_state();
+    let b = *s.periodic().unwrap();
+    for cutoff in [3.0 * d.ell, 8.0 * d.ell, 0.45 * l] {
+        for steric in [
+            None,
+            Some(swimlab::engine::Steric::new(2e-6, 1e-3).unwrap()),
+        ] {
+            let rates = |cells: bool| {
+                let mut sys = AveragedSystem::new(s.swimmers(), base, Coefficients::Paper, y);
+                sys.set_periodic(Some(b));
+                sys.set_cutoff(Some(cutoff));
+                sys.set_contacts(
+                    swimlab::engine::Contacts {
+                        allow_overlap: false,
+                        steric,
+                    },
+                    1e-3,
+                );
+                sys.set_cell_lists(Some(cells));
+                let mut dy = vec![0.0; y.len()];
+                sys.rhs(0.0, y, &mut dy);
+                dy
+            };
+            let (a, c) = (rates(true), rates(false));
+            let scale = c.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(scale > 0.0);
+            for (k, (x, z)) in a.iter().zip(&c).enumerate() {
+                assert!(
+                    (x - z).abs() <= 1e-12 * scale,
+                    "cutoff {cutoff:e}, steric {}, component {k}: {x:e} vs {z:e}",
+                    steric.is_some()
+                );
+            }
+        }
+    }
+}
+
+/// The contact guard through periodic cell lists (2,000 spheres, above the threshold) names the
+/// pair a brute-force minimum-image loop finds, an overlap across a face included; `min_gap`
+/// (cells of twice the mean spacing) gives the brute-force smallest gap.
+#[test]
+fn the_overlap_guard_sees_across_the_faces() {
+    use swimlab::engine::pairs::{closest_overlap, min_gap, SoaSpheres};
+    let b = PeriodicBox::new([60e-6, 50e-6, 55e-6]).unwrap();
+    let mut rng = Rng(0x6a09e667f3bcc909);
+    let n = 2000;
+    let mut s = SoaSpheres::default();
+    s.resize(n);
+    s.periodic = Some(b);
+    let radii: Vec<f64> = (0..n)
+        .map(|i| if i % 2 == 0 { 0.3e-6 } else { 0.2e-6 })
+        .collect();
+    let l = b.sides();
+    for i in 0..n {
+        s.x[i] = (rng.uniform() - 0.5) * l[0];
+        s.y[i] = (rng.uniform() - 0.5) * l[1];
+        s.z[i] = (rng.uniform() - 0.5) * l[2];
+    }
+    // Sphere 7 just across the x face from sphere 3, overlapping it by 0.45 µm (deeper than any
+    // random pair).
+    s.x[7] = s.x[3] + l[0] - (radii[3] + radii[7] - 0.45e-6);
+    (s.y[7], s.z[7]) = (s.y[3], s.z[3]);
+    let brute = || {
+        let mut best = (f64::INFINITY, 0, 0);
+        for i in 0..n {
+            for j in i + 1..n {
+                let r = Vector3::new(s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
+                let gap = b.min_image(r).norm() - radii[i] - radii[j];
+                if gap < best.0 {
+                    best = (gap, i, j);
+                }
+            }
+        }
+        best
+    };
+    let want = brute();
+    assert_eq!((want.1, want.2), (3, 7));
+    let got = closest_overlap(&s, &radii, true).expect("the overlap across the face");
+    assert_eq!((got.1, got.2), (3, 7));
+    assert!((got.0 - want.0).abs() < 1e-18);
+    let g = min_gap(&s, &radii, true).unwrap();
+    assert_eq!((g.1, g.2), (want.1, want.2));
 }

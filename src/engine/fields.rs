@@ -66,6 +66,12 @@ impl FieldKind {
 /// The most cells a field may have (64 MB of f64 for a nematic field).
 pub const MAX_CELLS: usize = 1 << 20;
 
+/// The most swimmer-to-cell deposits one field may take (a few seconds of work).
+pub const MAX_DEPOSITS: f64 = 1e9;
+
+/// The most centre-wave products one structure factor may take (a few seconds of work).
+pub const MAX_WAVE_PRODUCTS: f64 = 2e9;
+
 /// Grid and smoothing of a field.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FieldSpec {
@@ -182,6 +188,17 @@ impl Field {
             periodic: scene.periodic().is_some(),
             values: vec![0.0; n[0] * n[1] * n[2] * kind.components()],
         };
+        // Cells each swimmer touches: 8 widths across per axis, at most the grid.
+        let touched: f64 = (0..3)
+            .map(|d| ((8.0 * width / spacing[d]).ceil() + 1.0).min(n[d] as f64))
+            .product();
+        if touched * centres.len() as f64 > MAX_DEPOSITS {
+            return Err(invalid!(
+                "a field of {} swimmers with width {width:e} m on this grid spreads each swimmer over {touched:.0} cells, {:.1e} deposits in all (more than {MAX_DEPOSITS:e}, minutes of work); use a smaller width or a coarser grid",
+                centres.len(),
+                touched * centres.len() as f64
+            ));
+        }
         let sides = scene.periodic().map(|b| b.sides());
         f.deposit(&centres, &dirs, sides);
         Ok(f)
@@ -550,6 +567,13 @@ pub fn structure_factor(scene: &Scene, bins: usize, k_max: Option<f64>) -> Resul
                 }
             }
         }
+    }
+    if waves.len() as f64 * n as f64 > MAX_WAVE_PRODUCTS {
+        return Err(invalid!(
+            "the structure factor of {n} centres over {} wave vectors is {:.1e} products (more than {MAX_WAVE_PRODUCTS:e}, minutes of work); use a smaller k_max",
+            waves.len(),
+            waves.len() as f64 * n as f64
+        ));
     }
     // Per centre and axis the powers e^{i 2π n x/L}, n = 0..=m: a wave's phase is three products.
     let centres: Vec<Vector3<f64>> = (0..n).map(|i| scene.center(i)).collect::<Result<_>>()?;
