@@ -88,6 +88,22 @@ pub fn random_suspension(
     phases: Phases,
     seed: u64,
 ) -> Result<()> {
+    random_suspension_apart(scene, n, d, sides, orientations, phases, seed, None)
+}
+
+/// [`random_suspension`] with every sphere gap above `gap` (m) if given, instead of the default
+/// 4λ·max(w1, w2) the strokes can close.
+#[allow(clippy::too_many_arguments)]
+pub fn random_suspension_apart(
+    scene: &mut Scene,
+    n: usize,
+    d: Dumbbell,
+    sides: [f64; 3],
+    orientations: Orientations,
+    phases: Phases,
+    seed: u64,
+    gap: Option<f64>,
+) -> Result<()> {
     for side in sides {
         require_positive("box side", side, "m")?;
     }
@@ -98,7 +114,14 @@ pub fn random_suspension(
     }
     // Over a stroke a sphere moves by w·2λ along its axis (w = a_other/(a1+a2)): two spheres
     // placed further apart than 4λ·max(w1, w2) cannot be brought into contact by the strokes.
-    let margin = 4.0 * d.lambda * d.w1().max(d.w2());
+    let stroke = 4.0 * d.lambda * d.w1().max(d.w2());
+    let margin = match gap {
+        Some(g) => {
+            require_positive("gap", g, "m")?;
+            g.max(stroke)
+        }
+        None => stroke,
+    };
     let mut rng = Rng::new(seed);
     let max_tries = 1000 * (n + 1);
     let mut tries = 0;

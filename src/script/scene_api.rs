@@ -144,7 +144,7 @@ fn add_random(
     seed: INT,
     opts: &rhai::Map,
 ) -> ScriptResult<INT> {
-    use crate::engine::build::{box_side, random_suspension, Orientations, Phases};
+    use crate::engine::build::{box_side, random_suspension_apart, Orientations, Phases};
     if n < 0 {
         return Err(script_error(format!(
             "add_random: the number of swimmers must be >= 0, got {n}"
@@ -167,13 +167,15 @@ fn add_random(
     };
     let mut orientations = Orientations::Random;
     let mut phases = Phases::Random;
+    let mut gap = None;
     for (k, v) in opts {
         match k.as_str() {
             "aligned" => orientations = Orientations::Aligned(crate::engine::swimmer::unit_direction(super::convert::vector3("aligned", v)?).map_err(|e| script_error(format!("add_random: aligned: {e}")))?),
             "phase" => phases = Phases::Equal(number("phase", v)?),
+            "gap" => gap = Some(number("add_random: gap", v)?),
             other => {
                 return Err(script_error(format!(
-                    "add_random: unknown option \"{other}\"; use aligned: [x, y, z] and/or phase: number"
+                    "add_random: unknown option \"{other}\"; use aligned: [x, y, z], phase: number and/or gap: metres"
                 )))
             }
         }
@@ -183,7 +185,7 @@ fn add_random(
         Some(l) => l,
         None => [lift(box_side(n as usize, &d.params, phi))?; 3],
     };
-    lift(random_suspension(
+    lift(random_suspension_apart(
         &mut trial,
         n as usize,
         d.params,
@@ -191,6 +193,7 @@ fn add_random(
         orientations,
         phases,
         seed as u64,
+        gap,
     ))?;
     Ok(s.replace(trial))
 }
@@ -489,7 +492,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("phase", "phases", "phase(x) -> float\ns.phase(i) -> float", "phase(x): x radians wrapped to [0, 2 pi). s.phase(i): the stroke phase of swimmer i.", "print(phase(7.0)); let s = scene(); s.add(dumbbell(#{ phase: 1.0 })); print(s.phase(0));"),
     doc_entry!("phases", "phases", "s.phases -> array\ns.phases = [..]", "All stroke phases (rad) in swimmer order; assign one per swimmer.", docs::PAIR_PHASES),
     doc_entry!("set_phase", "phases", "s.set_phase(i, phi)", "Set the stroke phase of swimmer i (rad).", "let s = scene(); s.add(dumbbell()); s.set_phase(0, pi()); print(s.phases);"),
-    doc_entry!("add_random", "scene", "s.add_random(d, n, volume_fraction, seed) -> int\ns.add_random(d, n, volume_fraction, seed, #{ aligned: [x, y, z], phase: p }) -> int\ns.add_random(d, n, seed[, opts]) -> int  (in a periodic box)", "Add n copies of dumbbell d at random places in a cube centred on the origin, sized so that all spheres fill the given volume fraction (in a periodic box: the box itself, measured by minimum images), without overlaps (random sequential addition, seeded: the same seed gives the same scene). Orientations and phases are random unless fixed by the options. Returns the new swimmer count; on failure the scene is unchanged.", "let s = scene(); s.add_random(dumbbell(#{}), 20, 0.01, 1); print(s.count);"),
+    doc_entry!("add_random", "scene", "s.add_random(d, n, volume_fraction, seed) -> int\ns.add_random(d, n, volume_fraction, seed, #{ aligned: [x, y, z], phase: p }) -> int\ns.add_random(d, n, seed[, opts]) -> int  (in a periodic box)", "Add n copies of dumbbell d at random places in a cube centred on the origin, sized so that all spheres fill the given volume fraction (in a periodic box: the box itself, measured by minimum images), without overlaps (random sequential addition, seeded: the same seed gives the same scene). Orientations and phases are random unless fixed by the options; gap: m sets the smallest sphere gap at placement (default 4 lambda max(w1, w2), what the strokes can close). Returns the new swimmer count; on failure the scene is unchanged.", "let s = scene(); s.add_random(dumbbell(#{}), 20, 0.01, 1); print(s.count);"),
     doc_entry!("add_at", "scene", "s.add_at(d, centres: array) -> int", "Add a copy of dumbbell d (its orientation and phase) at every centre [x, y, z] (m) of the array, e.g. a lattice from the stdlib module \"lattice\". All or nothing: if one does not fit, the scene is unchanged. Returns the new swimmer count.", "import \"lattice\" as lattice; let s = scene(); s.add_at(dumbbell(), lattice::cubic(2, 2, 2, 20e-6)); print(s.count);"),
     doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
     doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
