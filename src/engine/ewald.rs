@@ -54,8 +54,12 @@ pub struct Ewald {
     finite_size: bool,
     xi: f64,
     rc2: f64,
-    /// Lattice vectors nL that can bring a minimum image within r_c (n = 0 included).
+    /// Lattice vectors nL that can bring a minimum image within r_c (n = 0 included), by length.
     shifts: Vec<Vector3<f64>>,
+    /// Their lengths, ascending.
+    shift_norms: Vec<f64>,
+    /// r_c.
+    rc: f64,
     waves: Vec<Wave>,
     /// Largest |n| per axis among the waves.
     n_max: [usize; 3],
@@ -141,6 +145,8 @@ impl Ewald {
                 }
             }
         }
+        shifts.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
+        let shift_norms = shifts.iter().map(|s| s.norm()).collect();
         let nk = l.map(|side| (kc * side / (2.0 * PI)).floor() as i32);
         let mut list = Vec::new();
         for i in 0..=nk[0] {
@@ -177,6 +183,8 @@ impl Ewald {
             xi,
             rc2: rc * rc,
             shifts,
+            shift_norms,
+            rc,
             waves: list,
             n_max: nk.map(|n| n.max(0) as usize),
         })
@@ -230,7 +238,12 @@ impl Ewald {
     #[inline]
     fn real_apply(&self, r0: &Vector3<f64>, s: f64, f: &Vector3<f64>) -> Vector3<f64> {
         let mut u = Vector3::zeros();
-        for sh in &self.shifts {
+        // |r0 + nL| ≥ |nL| − |r0|: the shifts, by length, are done once that exceeds r_c.
+        let reach = self.rc + r0.norm();
+        for (sh, &len) in self.shifts.iter().zip(&self.shift_norms) {
+            if len > reach {
+                break;
+            }
             let r = r0 + sh;
             let r2 = r.norm_squared();
             if r2 == 0.0 || r2 > self.rc2 {
