@@ -24,7 +24,7 @@
 
 use super::error::{invalid, Result};
 use super::mobility::{self_mobility, Mobility};
-use super::periodic::PeriodicBox;
+use super::periodic::{PeriodicBox, WavePhases};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -38,7 +38,7 @@ const PARALLEL_SPHERES: usize = 64;
 /// One reciprocal vector of the half space (its partner −k adds the same real part).
 #[derive(Debug, Clone, Copy)]
 struct Wave {
-    n: [i32; 3],
+    n: [i64; 3],
     k: Vector3<f64>,
     k2: f64,
     /// 2 (6π/V)(1 + k²/4ξ² + k⁴/8ξ⁴) e^{−k²/4ξ²}/k², in units of 1/(6πμ).
@@ -147,7 +147,7 @@ impl Ewald {
         }
         shifts.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
         let shift_norms = shifts.iter().map(|s| s.norm()).collect();
-        let nk = l.map(|side| (kc * side / (2.0 * PI)).floor() as i32);
+        let nk = l.map(|side| (kc * side / (2.0 * PI)).floor() as i64);
         let mut list = Vec::new();
         for i in 0..=nk[0] {
             for j in -nk[1]..=nk[1] {
@@ -234,10 +234,15 @@ impl Ewald {
         (-6.0 * self.xi + 40.0 / 3.0 * self.xi.powi(3) * s) / PI.sqrt()
     }
 
-    /// The real-space sum over the images of separation `r0` (a minimum image): Σ_n M(r0 + nL) f.
+    /// Every image r = r0 + nL of separation `r0` (a minimum image) within r_c, the particle's own
+    /// r = 0 left out, given to `visit` with |r|² and its real-space coefficients (c_I, c_rr).
     #[inline]
-    fn real_apply(&self, r0: &Vector3<f64>, s: f64, f: &Vector3<f64>) -> Vector3<f64> {
-        let mut u = Vector3::zeros();
+    fn real_images(
+        &self,
+        r0: &Vector3<f64>,
+        s: f64,
+        mut visit: impl FnMut(&Vector3<f64>, f64, f64, f64),
+    ) {
         // |r0 + nL| ≥ |nL| − |r0|: the shifts, by length, are done once that exceeds r_c.
         let reach = self.rc + r0.norm();
         for (sh, &len) in self.shifts.iter().zip(&self.shift_norms) {
@@ -249,25 +254,42 @@ impl Ewald {
             if r2 == 0.0 || r2 > self.rc2 {
                 continue;
             }
-            let d = r2.sqrt();
-            let (ci, crr) = self.real(d, s);
-            u += ci * f + r * (crr * r.dot(f) / r2);
+            let (ci, crr) = self.real(r2.sqrt(), s);
+            visit(&r, r2, ci, crr);
         }
+    }
+
+    /// The real-space sum over the images of separation `r0`: Σ_n M(r0 + nL) f.
+    #[inline]
+    fn real_apply(&self, r0: &Vector3<f64>, s: f64, f: &Vector3<f64>) -> Vector3<f64> {
+        let mut u = Vector3::zeros();
+        self.real_images(r0, s, |r, r2, ci, crr| {
+            u += ci * f + r * (crr * r.dot(f) / r2)
+        });
         u
     }
 
-    /// The overlapping-sphere correction at the nearest image `r0` (RPY only; zero when apart).
+    /// The overlapping-sphere correction (c_I, c_rr) at the nearest image `r0`, absolute units
+    /// (RPY only; `None` when apart).
     #[inline]
-    fn overlap_apply(&self, r0: &Vector3<f64>, ai: f64, aj: f64, f: &Vector3<f64>) -> Vector3<f64> {
+    fn overlap(&self, r0: &Vector3<f64>, ai: f64, aj: f64) -> Option<(f64, f64)> {
         let d = r0.norm();
         if !self.finite_size || d >= ai + aj || d == 0.0 {
-            return Vector3::zeros();
+            return None;
         }
         let (zi, zrr) = Mobility::Rpy.pair_coefficients(self.mu, d, ai, aj);
         let oseen = 1.0 / (8.0 * PI * self.mu * d);
         let fs = (ai * ai + aj * aj) / (24.0 * PI * self.mu * d * d * d);
-        let (ci, crr) = (zi - oseen - fs, zrr - oseen + 3.0 * fs);
-        ci * f + r0 * (crr * r0.dot(f) / (d * d))
+        Some((zi - oseen - fs, zrr - oseen + 3.0 * fs))
+    }
+
+    /// The overlapping-sphere correction applied to `f` (zero when apart).
+    #[inline]
+    fn overlap_apply(&self, r0: &Vector3<f64>, ai: f64, aj: f64, f: &Vector3<f64>) -> Vector3<f64> {
+        match self.overlap(r0, ai, aj) {
+            Some((ci, crr)) => ci * f + r0 * (crr * r0.dot(f) / r0.norm_squared()),
+            None => Vector3::zeros(),
+        }
     }
 
     /// u_i = Σ_j M_ij F_j − F_i/(6πμa_i) for every sphere: the periodic interaction velocities
@@ -283,7 +305,7 @@ impl Ewald {
         let unit = 1.0 / (6.0 * PI * self.mu);
         let parallel = n >= PARALLEL_SPHERES;
         // Reciprocal space: per wave, C = Σ_j F_j e^{−ik·x_j} and D = Σ_j a_j² F_j e^{−ik·x_j}.
-        let phases = self.phase_tables(pos);
+        let phases = WavePhases::new(&self.periodic, pos, self.n_max);
         let sums = |w: &Wave| {
             let mut c = [[0.0; 2]; 3];
             let mut d = [[0.0; 2]; 3];
@@ -348,33 +370,27 @@ impl Ewald {
     /// `ai`, `aj`; `same`: i = j (the block then includes the sphere's Stokes drag).
     pub fn block(&self, r0: &Vector3<f64>, ai: f64, aj: f64, same: bool) -> Matrix3<f64> {
         let unit = 1.0 / (6.0 * PI * self.mu);
-        let s = self.s(ai, aj);
         let mut m = Matrix3::zeros();
-        for q in 0..3 {
-            let e = Vector3::from_fn(|r, _| if r == q { 1.0 } else { 0.0 });
-            let mut col = self.real_apply(r0, s, &e);
-            if same {
-                col += (self.self_excess(ai) + 1.0 / ai) * e;
-            } else {
-                col += self.overlap_apply(r0, ai, aj, &e) / unit;
-            }
-            m.set_column(q, &col);
+        self.real_images(r0, self.s(ai, aj), |r, r2, ci, crr| {
+            m += ci * Matrix3::identity() + (crr / r2) * r * r.transpose();
+        });
+        if same {
+            m += (self.self_excess(ai) + 1.0 / ai) * Matrix3::identity();
+        } else if let Some((ci, crr)) = self.overlap(r0, ai, aj) {
+            m +=
+                (ci * Matrix3::identity() + (crr / r0.norm_squared()) * r0 * r0.transpose()) / unit;
         }
-        let k_part = |ai2: f64, aj2: f64| {
-            let mut t = Matrix3::zeros();
-            for w in &self.waves {
-                let factor = 1.0 - (ai2 + aj2) * w.k2 / 6.0;
-                let proj = Matrix3::identity() - w.k * w.k.transpose() / w.k2;
-                t += w.g * factor * w.k.dot(r0).cos() * proj;
-            }
-            t
-        };
         let (ai2, aj2) = if self.finite_size {
             (ai * ai, aj * aj)
         } else {
             (0.0, 0.0)
         };
-        (m + k_part(ai2, aj2)) * unit
+        for w in &self.waves {
+            let factor = 1.0 - (ai2 + aj2) * w.k2 / 6.0;
+            let proj = Matrix3::identity() - w.k * w.k.transpose() / w.k2;
+            m += w.g * factor * w.k.dot(r0).cos() * proj;
+        }
+        m * unit
     }
 
     /// The full 3N×3N periodic mobility matrix, Stokes drag included (tests, dense noise roots).
@@ -393,49 +409,6 @@ impl Ewald {
             }
         }
         m
-    }
-
-    /// e^{i 2π n x_d / L_d} for every sphere, axis and |n| ≤ n_max (the wave phases are products
-    /// of three of them: no sine or cosine per wave and sphere).
-    fn phase_tables(&self, pos: &[Vector3<f64>]) -> Phases {
-        let l = self.periodic.sides();
-        let widths = self.n_max.map(|m| m + 1);
-        let mut table = Vec::with_capacity(pos.len() * (widths[0] + widths[1] + widths[2]));
-        for p in pos {
-            for d in 0..3 {
-                let angle = 2.0 * PI * p[d] / l[d];
-                let (s1, c1) = angle.sin_cos();
-                let (mut re, mut im) = (1.0, 0.0);
-                for _ in 0..widths[d] {
-                    table.push((re, im));
-                    (re, im) = (re * c1 - im * s1, re * s1 + im * c1);
-                }
-            }
-        }
-        Phases { table, widths }
-    }
-}
-
-/// Powers e^{i 2π n x_d/L_d}, n = 0 … n_max, per sphere and axis.
-struct Phases {
-    table: Vec<(f64, f64)>,
-    widths: [usize; 3],
-}
-
-impl Phases {
-    /// e^{ik·x_j} = Π_d e^{i 2π n_d x_d/L_d} as (re, im); negative n_d conjugate.
-    #[inline]
-    fn at(&self, j: usize, n: [i32; 3]) -> (f64, f64) {
-        let stride = self.widths[0] + self.widths[1] + self.widths[2];
-        let mut base = j * stride;
-        let (mut re, mut im) = (1.0, 0.0);
-        for d in 0..3 {
-            let (a, b) = self.table[base + n[d].unsigned_abs() as usize];
-            let b = if n[d] < 0 { -b } else { b };
-            (re, im) = (re * a - im * b, re * b + im * a);
-            base += self.widths[d];
-        }
-        (re, im)
     }
 }
 

@@ -11,6 +11,7 @@
 
 use super::choice::{self, Choice, Named};
 use super::error::{invalid, Result};
+use super::periodic::WavePhases;
 use super::scene::Scene;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rayon::prelude::*;
@@ -575,32 +576,12 @@ pub fn structure_factor(scene: &Scene, bins: usize, k_max: Option<f64>) -> Resul
             waves.len() as f64 * n as f64
         ));
     }
-    // Per centre and axis the powers e^{i 2π n x/L}, n = 0..=m: a wave's phase is three products.
     let centres: Vec<Vector3<f64>> = (0..n).map(|i| scene.center(i)).collect::<Result<_>>()?;
-    let width = |d: usize| m[d] as usize + 1;
-    let stride = width(0) + width(1) + width(2);
-    let mut table = Vec::with_capacity(n * stride);
-    for c in &centres {
-        for d in 0..3 {
-            let (s1, c1) = (2.0 * PI * c[d] / l[d]).sin_cos();
-            let (mut re, mut im) = (1.0, 0.0);
-            for _ in 0..width(d) {
-                table.push((re, im));
-                (re, im) = (re * c1 - im * s1, re * s1 + im * c1);
-            }
-        }
-    }
+    let phases = WavePhases::new(b, &centres, m.map(|x| x as usize));
     let s_of = |&(idx, _): &([i64; 3], f64)| {
         let (mut sr, mut si) = (0.0, 0.0);
         for p in 0..n {
-            let mut base = p * stride;
-            let (mut re, mut im) = (1.0, 0.0);
-            for d in 0..3 {
-                let (a, bb) = table[base + idx[d].unsigned_abs() as usize];
-                let bb = if idx[d] < 0 { -bb } else { bb };
-                (re, im) = (re * a - im * bb, re * bb + im * a);
-                base += width(d);
-            }
+            let (re, im) = phases.at(p, idx);
             sr += re;
             si += im;
         }

@@ -72,6 +72,50 @@ impl PeriodicBox {
     }
 }
 
+/// The plane-wave phases e^{ik·x} of points in a box, for the box's wave vectors
+/// k = 2π(n_x/L_x, n_y/L_y, n_z/L_z) with |n_d| ≤ n_max[d]: per point and axis the powers
+/// e^{i 2π n x_d/L_d}, n = 0 … n_max, so that a wave's phase is three complex products, with no
+/// sine or cosine per wave and point (the Ewald sums' reciprocal part, the structure factor).
+#[derive(Debug, Clone)]
+pub struct WavePhases {
+    table: Vec<(f64, f64)>,
+    widths: [usize; 3],
+}
+
+impl WavePhases {
+    /// The tables of `points` in box `b` up to `n_max` per axis.
+    pub fn new(b: &PeriodicBox, points: &[Vector3<f64>], n_max: [usize; 3]) -> Self {
+        let widths = n_max.map(|m| m + 1);
+        let mut table = Vec::with_capacity(points.len() * (widths[0] + widths[1] + widths[2]));
+        for p in points {
+            for d in 0..3 {
+                let (s1, c1) = (2.0 * std::f64::consts::PI * p[d] / b.l[d]).sin_cos();
+                let (mut re, mut im) = (1.0, 0.0);
+                for _ in 0..widths[d] {
+                    table.push((re, im));
+                    (re, im) = (re * c1 - im * s1, re * s1 + im * c1);
+                }
+            }
+        }
+        WavePhases { table, widths }
+    }
+
+    /// e^{ik·x_j} for wave index `n` (|n_d| ≤ n_max[d]) as (re, im); a negative n_d conjugates.
+    #[inline]
+    pub fn at(&self, j: usize, n: [i64; 3]) -> (f64, f64) {
+        let stride = self.widths[0] + self.widths[1] + self.widths[2];
+        let mut base = j * stride;
+        let (mut re, mut im) = (1.0, 0.0);
+        for (d, &nd) in n.iter().enumerate() {
+            let (a, b) = self.table[base + nd.unsigned_abs() as usize];
+            let b = if nd < 0 { -b } else { b };
+            (re, im) = (re * a - im * b, re * b + im * a);
+            base += self.widths[d];
+        }
+        (re, im)
+    }
+}
+
 /// Separation `r` as the pair passes see it: its minimum image in a box, itself in open space.
 #[inline]
 pub fn separation(periodic: Option<&PeriodicBox>, r: Vector3<f64>) -> Vector3<f64> {
