@@ -123,6 +123,7 @@ impl From<BenchKind> for swimlab::bench::report::Kind {
             BenchKind::Backends => Kind::Backends,
             BenchKind::Pairs => Kind::Pairs,
             BenchKind::Scaling => Kind::Scaling,
+            BenchKind::Ewald => Kind::Ewald,
         }
     }
 }
@@ -144,6 +145,10 @@ enum BenchKind {
     /// microscopic and averaged models on the CPU (the averaged with a cutoff up to 8x larger)
     /// and on the GPU when an adapter is present, with fitted power-law exponents.
     Scaling,
+    /// The periodic box's mobility product: Beenakker's Ewald sums against spectral Ewald, 64 …
+    /// 15,625 spheres (--quick: up to 512; Beenakker up to 4,096), with open space for scale, the
+    /// methods' difference against the tolerance and the crossover "auto" uses.
+    Ewald,
 }
 
 fn main() -> ExitCode {

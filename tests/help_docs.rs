@@ -57,4 +57,5 @@ fn help_lists_every_choice_as_the_engine_defines_it() {
     check::<Coefficients>("coefficients");
     check::<Overlaps>("overlaps");
     check::<swimlab::engine::thermal::NoiseRoot>("noise_root");
+    check::<swimlab::engine::ewald::EwaldMethod>("ewald_method");
 }

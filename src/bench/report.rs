@@ -1,7 +1,7 @@
 //! `swimlab bench ...`: each benchmark's tables printed and written as CSV, with its pictures,
 //! under out/bench/. The command line only names the benchmark.
 
-use super::{backends, pairs, plots, scaling, stability, work_precision};
+use super::{backends, ewald, pairs, plots, scaling, stability, work_precision};
 use crate::engine::Model;
 
 /// The benchmarks `swimlab bench` runs.
@@ -17,6 +17,8 @@ pub enum Kind {
     Pairs,
     /// Cost per period against the number of swimmers.
     Scaling,
+    /// The periodic box's mobility product by both Ewald methods against size.
+    Ewald,
 }
 
 /// Run one benchmark, print its tables and write its CSV and pictures under out/bench/.
@@ -88,6 +90,24 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
             t.write_csv(std::path::Path::new("out/bench/pairs.csv"))
                 .map_err(io)?;
             println!("\nCSV written to out/bench/pairs.csv");
+        }
+        Kind::Ewald => {
+            let tol = crate::engine::ewald::DEFAULT_EWALD_TOL;
+            let (max, beenakker_max) = if quick { (512, 512) } else { (15625, 4096) };
+            let rows = ewald::run(max, beenakker_max, tol)?;
+            let t = ewald::table(&rows);
+            println!(
+                "periodic RPY product u = M F in a cube, tolerance {tol:e}, one sphere per (8 um)^3 on a jittered lattice ({} threads; medians of 3-5; open space: the all-pairs kernel at the same positions):\n{}",
+                rayon::current_num_threads(),
+                t.render()
+            );
+            match ewald::crossover(&rows) {
+                Some(n) => println!("spectral is faster from {n} spheres in this table; \"auto\" switches at {}", ewald::auto_threshold()),
+                None => println!("spectral is not faster at any size measured with both; \"auto\" switches at {}", ewald::auto_threshold()),
+            }
+            t.write_csv(std::path::Path::new("out/bench/ewald.csv"))
+                .map_err(io)?;
+            println!("\nCSV written to out/bench/ewald.csv");
         }
         Kind::Scaling => {
             let rows = scaling::run(if quick { 256 } else { 4096 })?;

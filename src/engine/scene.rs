@@ -10,7 +10,7 @@ use super::averaged::AveragedSystem;
 use super::backend::Backend;
 use super::contacts::{Contacts, Overlaps, Steric};
 use super::error::{invalid, require_finite, require_positive, unsupported, Result, Setting};
-use super::ewald::{Ewald, DEFAULT_EWALD_TOL};
+use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL};
 use super::integrators::{IntegratorSpec, OdeSystem, Stats};
 use super::micro::MicroSystem;
 use super::mobility::Mobility;
@@ -115,6 +115,13 @@ pub struct Scene {
         skip_serializing_if = "is_default_ewald_tol"
     )]
     ewald_tol: f64,
+    /// How the box's mobility products are summed (saved only when not "auto").
+    #[serde(default, skip_serializing_if = "is_auto_ewald")]
+    ewald_method: EwaldMethod,
+}
+
+fn is_auto_ewald(m: &EwaldMethod) -> bool {
+    *m == EwaldMethod::Auto
 }
 
 fn default_ewald_tol() -> f64 {
@@ -144,6 +151,7 @@ impl Default for Scene {
             thermal: Thermal::default(),
             periodic: None,
             ewald_tol: DEFAULT_EWALD_TOL,
+            ewald_method: EwaldMethod::Auto,
         }
     }
 }
@@ -373,16 +381,33 @@ impl Scene {
         Ok(())
     }
 
-    /// The box's periodic mobility for the sphere models (`None` in open space).
+    /// How the box's mobility products are summed: "auto", "beenakker" or "spectral".
+    pub fn ewald_method(&self) -> EwaldMethod {
+        self.ewald_method
+    }
+
+    /// Set how the box's mobility products are summed.
+    pub fn set_ewald_method(&mut self, method: EwaldMethod) {
+        self.ewald_method = method;
+    }
+
+    /// The box's periodic mobility for the sphere models (`None` in open space), its products by
+    /// the scene's Ewald method.
     pub(crate) fn ewald(&self) -> Result<Option<Ewald>> {
+        self.ewald_by(self.ewald_method)
+    }
+
+    /// The box's periodic mobility with products by `method`.
+    pub(crate) fn ewald_by(&self, method: EwaldMethod) -> Result<Option<Ewald>> {
         self.periodic
             .map(|b| {
-                Ewald::new(
+                Ewald::with_method(
                     b,
                     self.mu,
                     self.mobility,
                     2 * self.count(),
                     self.ewald_tol,
+                    method,
                     None,
                 )
             })

@@ -6,6 +6,7 @@ use super::convert::{lift, number, script_error, unknown_choice, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::choice::{self, Named};
+use crate::engine::ewald::EwaldMethod;
 use crate::engine::integrators::METHODS;
 use crate::engine::thermal::NoiseRoot;
 use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric};
@@ -121,6 +122,13 @@ pub fn register(engine: &mut Engine) {
         "overlaps",
         |s| s.contacts().overlaps(),
         Scene::set_overlaps,
+        any,
+    );
+    register_choice::<EwaldMethod>(
+        engine,
+        "ewald_method",
+        Scene::ewald_method,
+        Scene::set_ewald_method,
         any,
     );
     register_choice::<NoiseRoot>(
@@ -266,6 +274,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("steric", "numerics", "s.steric -> map or ()\ns.steric = #{ range, stiffness } | ()", "A soft repulsion between spheres of different swimmers: force stiffness * (range - gap) (N) along the line of centres when their surface gap is below range (m). Off by default (). Microscopic model: the forces join the spring forces in the mobility. Averaged model: each swimmer moves as a free-draining rigid dumbbell of length ell under them. Not in the rigid-stroke model; CPU only; costs one O(N^2) pass per right-hand side.", "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3 }; print(s.steric.range);"),
     doc_entry!("cutoff", "numerics", "s.cutoff -> float or ()\ns.cutoff = distance | ()", "Far-field cutoff of the averaged model (m): pairs further apart are left out. Off by default (). Each left-out pair's contribution is bounded by 9/64 v0 (28|A_R|(Lambda/ell) xi^3 + 84 c_J xi^4) with xi = ell/cutoff (README, Suspensions).", "let s = scene(); s.cutoff = 100e-6; print(s.cutoff);"),
     doc_entry!("box", "numerics", "s.box -> array or ()\ns.box = [Lx, Ly, Lz] | ()", "A periodic box of these sides (m) centred on the origin (-L/2 to L/2), or () for open space (the default). Pairs are measured by their minimum images; the sphere models use the periodic RPY (or Oseen) mobility by Ewald summation (Beenakker 1986, to s.ewald_tol, no net flow); the averaged model sums pairs within a cutoff of at most L/2 (L/2 when s.cutoff is not set). Snapshots, trajectories and fields show positions wrapped into the box; displacements and drift observables follow the unwrapped motion. add_random fills the box (s.add_random(d, n, seed)). CPU only. Saved with the scene.", "let s = scene(); s.box = [200e-6, 200e-6, 200e-6]; s.add_random(dumbbell(), 20, 1); print(s.box);"),
+    doc_entry!("ewald_method", "numerics", "s.ewald_method -> string\ns.ewald_method = \"auto\" | \"beenakker\" | \"spectral\"", "How the box's mobility products are summed for the spring model, s.sphere_velocities and the Lanczos noise root: \"beenakker\" sums over images and waves (O(N^2) per product); \"spectral\" is spectral Ewald (Lindbo & Tornberg 2010, the wave part of Fiore et al.'s positively split Ewald): real-space pairs within a cutoff of at most L/2 through cell lists, the wave part on an FFT grid (O(N log N)); \"auto\" (default) takes Beenakker below 700 spheres and spectral from there (the measured crossover, swimlab bench ewald). Both keep s.ewald_tol. The rigid model's constraint solve and the dense noise root take blocks, which are always Beenakker's. Saved with the scene.", "let s = scene(); s.ewald_method = \"spectral\"; print(s.ewald_method);"),
     doc_entry!("ewald_tol", "numerics", "s.ewald_tol -> float\ns.ewald_tol = tol", "Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility (default 1e-10; 1e-15 to 1e-2). Both the real-space and the reciprocal sums are cut where their terms fall below it; the splitting is chosen for speed and the result does not depend on it.", "let s = scene(); s.ewald_tol = 1e-12; print(s.ewald_tol);"),
     doc_entry!("coefficients", "numerics", "s.coefficients -> string\ns.coefficients = \"paper\" | \"leading_order\"", "Coefficients of the averaged model's I and J terms: as published, or the leading-order ones.", "let s = scene(); s.coefficients = \"leading_order\"; print(s.coefficients);"),
     doc_entry!("integrator_info", "numerics", "s.integrator_info -> string", "What the integrator runs on this scene: for auto(tol) the method it chose and why, else the integrator and whether it is the model's default.", "let s = scene(); s.add(dumbbell()); s.integrator = auto(1e-3); print(s.integrator_info);"),

@@ -99,7 +99,8 @@ impl Scene {
                     self.mobility,
                     self.contacts.allow_overlap,
                 );
-                sys.set_periodic(self.ewald()?);
+                // The constraint solve takes blocks, which are Beenakker's sums.
+                sys.set_periodic(self.ewald_by(EwaldMethod::Beenakker)?);
                 Box::new(sys)
             }
             Model::Averaged => {
