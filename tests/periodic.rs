@@ -617,4 +617,18 @@ fn the_ewald_method_is_a_scene_setting() {
     assert!(json.contains("\"ewald_method\": \"spectral\""), "{json}");
     let back = Scene::from_json(&json).unwrap();
     assert_eq!(back.ewald_method(), EwaldMethod::Spectral);
+    // A short microscopic run by each method: the displacements agree to 1e-9 of their size (the
+    // sums' 1e-10 of the Stokes velocity on every velocity; measured 2.7e-11).
+    let run = |m: EwaldMethod| {
+        let mut sc = back.clone();
+        sc.set_ewald_method(m);
+        let mut sim = swimlab::engine::Simulation::new(sc);
+        sim.run_periods(0.01).unwrap();
+        (0..30)
+            .map(|i| sim.scene().displacement(i).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let (by_b, by_s) = (run(EwaldMethod::Beenakker), run(EwaldMethod::Spectral));
+    let err = max_diff(&by_s, &by_b) / max_norm(&by_b);
+    assert!(err < 1e-9, "runs differ by {err:e}");
 }
