@@ -632,3 +632,38 @@ fn the_ewald_method_is_a_scene_setting() {
     let err = max_diff(&by_s, &by_b) / max_norm(&by_b);
     assert!(err < 1e-9, "runs differ by {err:e}");
 }
+
+/// `swimlab bench ewald` measures what it says: both methods at each size, their difference
+/// within the tolerance, and the crossover read off the table (from the first size after the
+/// last one where Beenakker's sums were faster).
+#[test]
+fn bench_ewald_compares_the_methods() {
+    use swimlab::bench::ewald::{crossover, run, table, Row};
+    let rows = run(125, 125, 1e-8).unwrap();
+    assert_eq!(
+        rows.iter().map(|r| r.spheres).collect::<Vec<_>>(),
+        [64, 125]
+    );
+    for r in &rows {
+        assert!(r.difference.unwrap() < 1.0, "{r:?}");
+        assert!(r.spectral > 0.0 && r.open > 0.0 && r.beenakker.unwrap() > 0.0);
+    }
+    assert_eq!(table(&rows).rows.len(), 2);
+    let row = |n, b: Option<f64>, s| Row {
+        spheres: n,
+        beenakker: b,
+        spectral: s,
+        open: 1.0,
+        grid: [8; 3],
+        difference: None,
+    };
+    let synthetic = [
+        row(10, Some(1.0), 2.0),
+        row(20, Some(3.0), 2.0),
+        row(40, Some(1.0), 2.0),
+        row(80, Some(9.0), 2.0),
+        row(160, None, 2.0),
+    ];
+    assert_eq!(crossover(&synthetic), Some(80));
+    assert_eq!(crossover(&synthetic[..3]), None);
+}
