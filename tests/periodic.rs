@@ -667,3 +667,27 @@ fn bench_ewald_compares_the_methods() {
     assert_eq!(crossover(&synthetic), Some(80));
     assert_eq!(crossover(&synthetic[..3]), None);
 }
+
+/// A box too elongated for the spectral grid: "spectral" says so and names the fixes, "auto"
+/// sums by Beenakker's method instead.
+#[test]
+fn an_elongated_box_falls_back_to_beenakker() {
+    let b = PeriodicBox::new([12e-6, 12e-6, 12e-3]).unwrap();
+    let err = Ewald::with_method(
+        b,
+        MU,
+        Mobility::Rpy,
+        800,
+        1e-10,
+        EwaldMethod::Spectral,
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("beenakker") && err.contains("tolerance"),
+        "{err}"
+    );
+    let e = Ewald::with_method(b, MU, Mobility::Rpy, 800, 1e-10, EwaldMethod::Auto, None).unwrap();
+    assert_eq!(e.method(), EwaldMethod::Beenakker);
+}

@@ -335,7 +335,14 @@ impl Ewald {
             return Self::new(periodic, mu, mobility, spheres, tol, xi);
         }
         let mut e = Self::new(periodic, mu, mobility, 1, tol, None)?;
-        e.spectral = Some(SpectralEwald::new(periodic, e.split, spheres, tol, xi)?);
+        match SpectralEwald::new(periodic, e.split, spheres, tol, xi) {
+            Ok(g) => e.spectral = Some(g),
+            // A box too elongated for the grid: "auto" sums by Beenakker's method instead.
+            Err(_) if method == EwaldMethod::Auto => {
+                return Self::new(periodic, mu, mobility, spheres, tol, xi)
+            }
+            Err(err) => return Err(err),
+        }
         Ok(e)
     }
 

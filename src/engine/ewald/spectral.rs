@@ -164,7 +164,7 @@ impl SpectralEwald {
         let points: usize = m.iter().product();
         if points > MAX_GRID_POINTS {
             return Err(invalid!(
-                "the spectral Ewald grid would need {}×{}×{} points (at most {MAX_GRID_POINTS}); loosen the Ewald tolerance or take a smaller box",
+                "the spectral Ewald grid would need {}×{}×{} points (at most {MAX_GRID_POINTS}); loosen the Ewald tolerance, make the box less elongated, or sum by Beenakker's method (Ewald method \"beenakker\")",
                 m[0],
                 m[1],
                 m[2]
