@@ -55,8 +55,13 @@ fn transcript_of_a_session() {
     // Ctrl-C during a long run stops it at a step boundary and keeps the scene and the rows.
     // The progress bar (shown once a run has lasted half a second) says the run has begun: a
     // Ctrl-C before it would be cleared with the command's start on a slow machine.
+    // The first run of a process under backend "auto" with an adapter present (lavapipe in CI)
+    // first times both backends (engine/calibrate.rs): tens of seconds on a loaded machine, so the
+    // bar may take longer than the usual wait.
     s.send_line("s.run_periods(1000000);").unwrap();
+    s.set_expect_timeout(Some(Duration::from_secs(120)));
     s.expect("periods/s").expect("the run has begun");
+    s.set_expect_timeout(Some(Duration::from_secs(20)));
     s.send(ControlCode::EndOfText).unwrap();
     s.expect("run interrupted at t =").unwrap();
     s.expect(PROMPT).unwrap();
