@@ -531,14 +531,10 @@ pub fn structure_factor(scene: &Scene, bins: usize, k_max: Option<f64>) -> Resul
     let limit = 2.0 * PI * MAX_WAVE_INDEX as f64 / l[0].max(l[1]).max(l[2]);
     let k_max = match k_max {
         Some(k) if k.is_finite() && k > 0.0 => {
-            let top = (0..3)
-                .map(|d| (k * l[d] / (2.0 * PI)).floor() as usize)
-                .max()
-                .unwrap_or(0);
+            let top = b.wave_index_max(k).into_iter().max().unwrap_or(0);
             if top > MAX_WAVE_INDEX {
                 return Err(invalid!(
-                    "k_max = {k:e} 1/m needs {top} waves per axis in this box, more than {MAX_WAVE_INDEX}; use k_max up to {:e} 1/m",
-                    2.0 * PI * MAX_WAVE_INDEX as f64 / l[0].max(l[1]).max(l[2])
+                    "k_max = {k:e} 1/m needs {top} waves per axis in this box, more than {MAX_WAVE_INDEX}; use k_max up to {limit:e} 1/m"
                 ));
             }
             k
@@ -550,25 +546,11 @@ pub fn structure_factor(scene: &Scene, bins: usize, k_max: Option<f64>) -> Resul
         }
         None => (1.5 * 2.0 * PI / spacing).min(limit),
     };
-    let m: [i64; 3] = std::array::from_fn(|d| (k_max * l[d] / (2.0 * PI)).floor() as i64);
-    let mut waves = Vec::new();
-    for i in 0..=m[0] {
-        for j in -m[1]..=m[1] {
-            for k in -m[2]..=m[2] {
-                if i == 0 && (j < 0 || (j == 0 && k <= 0)) {
-                    continue;
-                }
-                let kv = Vector3::new(
-                    2.0 * PI * i as f64 / l[0],
-                    2.0 * PI * j as f64 / l[1],
-                    2.0 * PI * k as f64 / l[2],
-                );
-                if kv.norm() <= k_max {
-                    waves.push(([i, j, k], kv.norm()));
-                }
-            }
-        }
-    }
+    let waves: Vec<([i64; 3], f64)> = b
+        .half_space_waves(k_max)
+        .into_iter()
+        .map(|(idx, k)| (idx, k.norm()))
+        .collect();
     if waves.len() as f64 * n as f64 > MAX_WAVE_PRODUCTS {
         return Err(invalid!(
             "the structure factor of {n} centres over {} wave vectors is {:.1e} products (more than {MAX_WAVE_PRODUCTS:e}, minutes of work); use a smaller k_max",
@@ -577,7 +559,7 @@ pub fn structure_factor(scene: &Scene, bins: usize, k_max: Option<f64>) -> Resul
         ));
     }
     let centres: Vec<Vector3<f64>> = (0..n).map(|i| scene.center(i)).collect::<Result<_>>()?;
-    let phases = WavePhases::new(b, &centres, m.map(|x| x as usize));
+    let phases = WavePhases::new(b, &centres, b.wave_index_max(k_max));
     let s_of = |&(idx, _): &([i64; 3], f64)| {
         let (mut sr, mut si) = (0.0, 0.0);
         for p in 0..n {

@@ -72,6 +72,44 @@ impl PeriodicBox {
     }
 }
 
+impl PeriodicBox {
+    /// The box's wave vectors k = 2π(n_x/L_x, n_y/L_y, n_z/L_z) ≠ 0 with |k| ≤ `k_max`, one of each
+    /// ±k pair (n_x > 0, or n_x = 0 and n_y > 0, or n_x = n_y = 0 and n_z > 0), as (n, k).
+    pub fn half_space_waves(&self, k_max: f64) -> Vec<([i64; 3], Vector3<f64>)> {
+        let l = self.l;
+        let m = self.wave_index_max(k_max).map(|n| n as i64);
+        let mut waves = Vec::new();
+        for i in 0..=m[0] {
+            for j in -m[1]..=m[1] {
+                for k in -m[2]..=m[2] {
+                    if i == 0 && (j < 0 || (j == 0 && k <= 0)) {
+                        continue;
+                    }
+                    let tau = 2.0 * std::f64::consts::PI;
+                    let kv = Vector3::new(
+                        tau * i as f64 / l[0],
+                        tau * j as f64 / l[1],
+                        tau * k as f64 / l[2],
+                    );
+                    if kv.norm() <= k_max {
+                        waves.push(([i, j, k], kv));
+                    }
+                }
+            }
+        }
+        waves
+    }
+
+    /// The largest |n_d| per axis among the waves with |k| ≤ `k_max`.
+    pub fn wave_index_max(&self, k_max: f64) -> [usize; 3] {
+        self.l.map(|side| {
+            (k_max * side / (2.0 * std::f64::consts::PI))
+                .floor()
+                .max(0.0) as usize
+        })
+    }
+}
+
 /// The plane-wave phases e^{ik·x} of points in a box, for the box's wave vectors
 /// k = 2π(n_x/L_x, n_y/L_y, n_z/L_z) with |n_d| ≤ n_max[d]: per point and axis the powers
 /// e^{i 2π n x_d/L_d}, n = 0 … n_max, so that a wave's phase is three complex products, with no

@@ -272,35 +272,16 @@ impl Ewald {
         }
         shifts.sort_by(|a, b| a.norm().total_cmp(&b.norm()));
         let shift_norms = shifts.iter().map(|s| s.norm()).collect();
-        let nk = l.map(|side| (kc * side / (2.0 * PI)).floor() as i64);
-        let mut list = Vec::new();
-        for i in 0..=nk[0] {
-            for j in -nk[1]..=nk[1] {
-                for k in -nk[2]..=nk[2] {
-                    // The half space: one of each ±k pair.
-                    if i == 0 && (j < 0 || (j == 0 && k <= 0)) {
-                        continue;
-                    }
-                    let kv = Vector3::new(
-                        2.0 * PI * i as f64 / l[0],
-                        2.0 * PI * j as f64 / l[1],
-                        2.0 * PI * k as f64 / l[2],
-                    );
-                    let k2 = kv.norm_squared();
-                    if k2 > kc * kc {
-                        continue;
-                    }
-                    let q = k2 / (4.0 * xi * xi);
-                    let g = 2.0 * 6.0 * PI / volume * (1.0 + q + 2.0 * q * q) * (-q).exp() / k2;
-                    list.push(Wave {
-                        n: [i, j, k],
-                        k: kv,
-                        k2,
-                        g,
-                    });
-                }
-            }
-        }
+        let list = periodic
+            .half_space_waves(kc)
+            .into_iter()
+            .map(|(n, k)| {
+                let k2 = k.norm_squared();
+                let q = k2 / (4.0 * xi * xi);
+                let g = 2.0 * 6.0 * PI / volume * (1.0 + q + 2.0 * q * q) * (-q).exp() / k2;
+                Wave { n, k, k2, g }
+            })
+            .collect();
         Ok(Ewald {
             periodic,
             split: Split {
@@ -313,7 +294,7 @@ impl Ewald {
             shift_norms,
             rc,
             waves: list,
-            n_max: nk.map(|n| n.max(0) as usize),
+            n_max: periodic.wave_index_max(kc),
             spectral: None,
         })
     }

@@ -49,6 +49,9 @@ fn support_points(tol: f64) -> usize {
 /// below 0.35 tol from 1e-4 to 1e-12, cubic and elongated boxes, RPY and Oseen).
 const OVERSAMPLE: f64 = 1.3;
 
+/// A sphere's Gaussian support: per axis the first grid index (wrapped) and the P weights.
+type Support = ([usize; 3], [[f64; 32]; 3]);
+
 /// The smallest n ≥ `at_least` whose only prime factors are 2, 3 and 5 (fast FFT lengths).
 fn smooth(at_least: usize) -> usize {
     (at_least.max(1)..)
@@ -179,14 +182,8 @@ impl SpectralEwald {
         let norm = (alpha / PI).powf(1.5);
         let cell = h[0] * h[1] * h[2];
         let volume = periodic.volume();
-        let mode = |i: usize, n: usize| -> Option<f64> {
-            let j = if i <= n / 2 {
-                i as i64
-            } else {
-                i as i64 - n as i64
-            };
-            (!(n % 2 == 0 && i == n / 2)).then_some(j as f64)
-        };
+        // The Nyquist planes of even grids are left out (their waves have no ± partner).
+        let mode = |i: usize, n: usize| (!(n % 2 == 0 && i == n / 2)).then(|| signed_mode(i, n));
         let mut kernel = vec![0.0; points];
         kernel
             .par_chunks_mut(m[2] * m[1])
@@ -245,7 +242,7 @@ impl SpectralEwald {
     }
 
     /// The Gaussian's support at `x`: per axis the first grid index (wrapped) and the P weights.
-    fn support(&self, x: &Vector3<f64>) -> ([usize; 3], [[f64; 32]; 3]) {
+    fn support(&self, x: &Vector3<f64>) -> Support {
         let l = self.periodic.sides();
         let mut start = [0; 3];
         let mut w = [[0.0; 32]; 3];
@@ -284,7 +281,8 @@ impl SpectralEwald {
                 }
             })
             .collect();
-        let mut grid = self.spread(pos, &a2, forces);
+        let supports: Vec<Support> = pos.iter().map(|x| self.support(x)).collect();
+        let mut grid = self.spread(&supports, &a2, forces);
         let mut spare: [Vec<Complex64>; 3] =
             std::array::from_fn(|_| vec![Complex64::default(); grid[0].len()]);
         self.forward(&mut grid, &mut spare);
@@ -294,7 +292,7 @@ impl SpectralEwald {
         let wave = &spare;
         self.real_space(pos, radii, forces, out);
         let gather = |(i, u): (usize, &mut Vector3<f64>)| {
-            let (start, w) = self.support(&pos[i]);
+            let (start, w) = &supports[i];
             let mut re = [0.0; 3];
             let mut im = [0.0; 3];
             let [mx, my, mz] = self.m;
@@ -383,14 +381,13 @@ impl SpectralEwald {
     /// pass. Each plane is written in a fixed order, so the sums do not depend on the thread count.
     fn spread(
         &self,
-        pos: &[Vector3<f64>],
+        supports: &[Support],
         a2: &[f64],
         forces: &[Vector3<f64>],
     ) -> [Vec<Complex64>; 3] {
         let [mx, my, mz] = self.m;
         let plane = mx * my;
         let thick = self.p;
-        let supports: Vec<_> = pos.iter().map(|x| self.support(x)).collect();
         let mut members = vec![Vec::new(); mz.div_ceil(thick)];
         for (j, (start, _)) in supports.iter().enumerate() {
             members[start[2] / thick].push(j);
@@ -411,6 +408,11 @@ impl SpectralEwald {
                 let planes = f[0].len() / plane;
                 for (tz, wz) in w[2].iter().take(self.p).enumerate() {
                     let gz = start[2] + tz;
+                    // Past the last plane: into `over`, wrapped later.
+                    let inside = gz - first < planes;
+                    if !inside && over.is_empty() {
+                        over.resize(3 * thick * plane, Complex64::default());
+                    }
                     for (ty, wy) in w[1].iter().take(self.p).enumerate() {
                         let row = mx * ((start[1] + ty) % my);
                         let wyz = wy * wz;
@@ -418,14 +420,10 @@ impl SpectralEwald {
                             let wx = &w[0][t0..t0 + len];
                             for (q, cq) in c.iter().enumerate() {
                                 let cq = cq * wyz;
-                                let dst = if gz - first < planes {
+                                let dst = if inside {
                                     let at = (gz - first) * plane + row + gx;
                                     &mut f[q][at..at + len]
                                 } else {
-                                    // Past the last plane: wrapped later.
-                                    if over.is_empty() {
-                                        over.resize(3 * thick * plane, Complex64::default());
-                                    }
                                     let at = (q * thick + gz - mz) * plane + row + gx;
                                     &mut over[at..at + len]
                                 };
@@ -473,7 +471,7 @@ impl SpectralEwald {
         let [mx, my, mz] = self.m;
         for q in 0..3 {
             rows(&*self.fft[0][0], &mut grid[q], mx * my);
-            xyz_to_yxz(&grid[q], &mut spare[q], self.m);
+            transpose_planes(&grid[q], &mut spare[q], mx, my);
             rows(&*self.fft[1][0], &mut spare[q], my * mx);
             // (y, x, z) → (z, y, x).
             yxz_to_zyx(&spare[q], &mut grid[q], self.m);
@@ -488,7 +486,7 @@ impl SpectralEwald {
             rows(&*self.fft[2][1], &mut grid[q], mz * my);
             zyx_to_yxz(&grid[q], &mut spare[q], self.m);
             rows(&*self.fft[1][1], &mut spare[q], my * mx);
-            yxz_to_xyz(&spare[q], &mut grid[q], self.m);
+            transpose_planes(&spare[q], &mut grid[q], my, mx);
             rows(&*self.fft[0][1], &mut grid[q], mx * my);
         }
     }
@@ -499,14 +497,7 @@ impl SpectralEwald {
     fn apply_kernel(&self, z: &[Vec<Complex64>; 3], out: &mut [Vec<Complex64>; 3], aref2: f64) {
         let [mx, my, mz] = self.m;
         let l = self.periodic.sides();
-        let wavenumber = |i: usize, n: usize, side: f64| {
-            let j = if i <= n / 2 {
-                i as f64
-            } else {
-                i as f64 - n as f64
-            };
-            2.0 * PI * j / side
-        };
+        let wavenumber = |i: usize, n: usize, side: f64| 2.0 * PI * signed_mode(i, n) / side;
         let finite = self.split.finite_size;
         let [o0, o1, o2] = out;
         o0.par_chunks_mut(mz * my)
@@ -568,6 +559,15 @@ impl SpectralEwald {
     }
 }
 
+/// The wave index of FFT output `i` of `n`: i up to n/2, i − n above.
+fn signed_mode(i: usize, n: usize) -> f64 {
+    if i <= n / 2 {
+        i as f64
+    } else {
+        i as f64 - n as f64
+    }
+}
+
 /// The support's P points along x from grid index `start` in a row of `m` points, as at most two
 /// runs (grid index, first weight, length): the second one after the wrap.
 fn x_runs(start: usize, p: usize, m: usize) -> ([(usize, usize, usize); 2], usize) {
@@ -589,29 +589,15 @@ fn rows(fft: &dyn Fft<f64>, data: &mut [Complex64], chunk: usize) {
     );
 }
 
-/// dst(y, x, z) = src(x, y, z): each layout's first index fastest.
-fn xyz_to_yxz(src: &[Complex64], dst: &mut [Complex64], [mx, my, _]: [usize; 3]) {
-    dst.par_chunks_mut(mx * my)
-        .enumerate()
-        .for_each(|(z, plane)| {
-            let from = &src[z * mx * my..(z + 1) * mx * my];
-            for x in 0..mx {
-                for y in 0..my {
-                    plane[y + my * x] = from[x + mx * y];
-                }
-            }
-        });
-}
-
-/// dst(x, y, z) = src(y, x, z).
-fn yxz_to_xyz(src: &[Complex64], dst: &mut [Complex64], [mx, my, _]: [usize; 3]) {
-    dst.par_chunks_mut(mx * my)
-        .enumerate()
-        .for_each(|(z, plane)| {
-            let from = &src[z * mx * my..(z + 1) * mx * my];
-            for y in 0..my {
-                for x in 0..mx {
-                    plane[x + mx * y] = from[y + my * x];
+/// Each plane of `src` (`rows` rows of `cols` points) transposed into `dst`: dst[r + rows·c] =
+/// src[c + cols·r], plane by plane ((x, y, z) ↔ (y, x, z) layouts, each's first index fastest).
+fn transpose_planes(src: &[Complex64], dst: &mut [Complex64], cols: usize, rows: usize) {
+    dst.par_chunks_mut(cols * rows)
+        .zip(src.par_chunks(cols * rows))
+        .for_each(|(to, from)| {
+            for c in 0..cols {
+                for r in 0..rows {
+                    to[r + rows * c] = from[c + cols * r];
                 }
             }
         });
