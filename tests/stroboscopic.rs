@@ -46,7 +46,7 @@ impl OdeSystem for Forced {
 /// periods each, and the exact end state.
 fn forced_end(eps: f64, m: u64) -> (f64, f64) {
     let mut sys = Forced { eps, a: 0.5 };
-    let mut st = Stroboscopic::new(1e-6, 1.0, Box::new(Rk4::new(1.0 / 400.0)), 0, 0, 1.0)
+    let mut st = Stroboscopic::new(1e-6, 1.0, Box::new(Rk4::new(1.0 / 400.0)), 0, 1.0)
         .with_fixed_macro_steps(m);
     let mut y = vec![1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
     let (mut t, t_end) = (0.0, 800.0);

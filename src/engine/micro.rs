@@ -140,6 +140,19 @@ impl OdeSystem for MicroSystem {
         }
     }
 
+    /// The fast variable of a dumbbell is its length |b| (the spring relaxes at
+    /// [`Dumbbell::relaxation_rate`]); its centre R_H and direction b̂ are slow.
+    fn settle_like(&self, settled: &[f64], y: &mut [f64]) {
+        for s in 0..self.swimmers.len() {
+            let i = STATE_PER_SWIMMER * s + 3;
+            let b = vec3(y, i);
+            let (len, settled_len) = (b.norm(), vec3(settled, i).norm());
+            if len > 0.0 && len.is_finite() {
+                set_vec3(y, i, &(b * (settled_len / len)));
+            }
+        }
+    }
+
     fn jacobian_block(&self) -> usize {
         STATE_PER_SWIMMER
     }

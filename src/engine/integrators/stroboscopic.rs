@@ -6,11 +6,13 @@
 //! and a macro integrator takes steps of many periods on the smooth flow those samples define.
 //!
 //! - **Slope.** The slope F(y) of the averaged flow at y is read off three consecutive
-//!   stroboscopic points Z_r = Ψ^r(y), Z_{r+1}, Z_{r+2}: the derivative at s = 0 of the quadratic
-//!   through them at s = r, r+1, r+2 periods (second order in T). The first r periods relax what
-//!   is fast (a spring settles at its relaxation rate): only points on the slow manifold enter the
-//!   slope, so the macro flow is not stiff, and an extrapolated stage state slightly off the
-//!   manifold costs nothing. Without fast variables (the rigid-stroke model) r = 0.
+//!   stroboscopic points y, Ψ(y), Ψ²(y): the derivative at s = 0 of the quadratic through them
+//!   at s = 0, 1, 2 periods (second order in T). A stage state, extrapolated from states on the
+//!   slow manifold, is put back next to it first ([`OdeSystem::settle_like`]: each spring gets
+//!   the length it has in the step's start state, of the same phase), so the fast motion (a
+//!   spring settling at its relaxation rate) has next to nothing to relax and the macro flow is
+//!   not stiff. Without settling, an extrapolated turn stretches a dumbbell by ~ℓθ²/2; the slope
+//!   then carries that stretch relaxing within a period, and the next stage fails the guards.
 //! - **Macro steps.** Dormand-Prince 5(4) (first-same-as-last: six new slopes a step) in whole
 //!   periods, H = mT, so every macro state is a stroboscopic state of the same phase; every
 //!   stage's Ψ starts at the step's own time. Fifth order rather than Bogacki-Shampine's third:
@@ -29,9 +31,8 @@
 use super::dopri5::{A, E};
 use super::system::{check_state, Interrupt, OdeSystem, Problem, Stats, StepFailure, Stepper};
 
-/// Fewest periods a macro step spans: a step's samples cost 6 (r + 2) periods of microscopic
-/// work (r relaxation periods per slope: 12 to 18 periods at r ≤ 1), so fewer are integrated
-/// directly.
+/// Fewest periods a macro step spans: a step's samples cost 6 × 2 = 12 periods of microscopic
+/// work, so fewer are integrated directly.
 pub const MIN_MACRO: u64 = 16;
 
 /// The order in H of the error estimate relative to the change the step makes: the local error
@@ -50,8 +51,6 @@ pub struct Stroboscopic {
     tol: f64,
     period: f64,
     inner: Box<dyn Stepper>,
-    /// Relaxation periods before the slope's three points.
-    relax: u32,
     /// Periods integrated directly after a start.
     transient: u32,
     /// A length scale for the positions' round-off allowance (m).
@@ -72,14 +71,13 @@ pub struct Stroboscopic {
 
 impl Stroboscopic {
     /// A stepper of tolerance `tol` (relative to the drift) for a system of common period `period`
-    /// (s), sampling the stroboscopic map with `inner`, relaxing `relax` periods before each slope
-    /// and integrating `transient` periods directly after a start. `length` (m) scales the
-    /// positions' round-off allowance.
+    /// (s), sampling the stroboscopic map with `inner` and integrating `transient` periods
+    /// directly after a start (the fast motion settles onto the slow manifold). `length` (m)
+    /// scales the positions' round-off allowance.
     pub fn new(
         tol: f64,
         period: f64,
         inner: Box<dyn Stepper>,
-        relax: u32,
         transient: u32,
         length: f64,
     ) -> Self {
@@ -87,7 +85,6 @@ impl Stroboscopic {
             tol,
             period,
             inner,
-            relax,
             transient,
             length,
             h_periods: f64::INFINITY,
@@ -157,7 +154,8 @@ impl Stroboscopic {
         Ok(())
     }
 
-    /// The slope of the averaged flow at `y` (phase of `t`), from Ψ^r, Ψ^{r+1}, Ψ^{r+2}.
+    /// The slope of the averaged flow at `y` (phase of `t`), from y, Ψ(y), Ψ²(y): the derivative
+    /// at 0 of the quadratic through them, (−3y + 4Ψ(y) − Ψ²(y)) / 2T.
     fn slope_at(
         &mut self,
         sys: &mut dyn OdeSystem,
@@ -165,24 +163,14 @@ impl Stroboscopic {
         y: &[f64],
         stats: &mut Stats,
     ) -> Result<Vec<f64>, StepFailure> {
-        let r = self.relax as f64;
-        // Derivative at 0 of the Lagrange basis on the nodes r, r+1, r+2 (in periods).
-        let nodes = [r, r + 1.0, r + 2.0];
-        let w: Vec<f64> = (0..3)
-            .map(|j| {
-                let (a, b) = ((j + 1) % 3, (j + 2) % 3);
-                let denom = (nodes[j] - nodes[a]) * (nodes[j] - nodes[b]);
-                -(nodes[a] + nodes[b]) / denom / self.period
-            })
-            .collect();
+        let w = [-1.5 / self.period, 2.0 / self.period, -0.5 / self.period];
         let mut z = y.to_vec();
-        self.psi(sys, t, &mut z, self.relax, stats)?;
         let mut f: Vec<f64> = z.iter().map(|v| w[0] * v).collect();
-        let t_r = t + r * self.period;
-        for wj in &w[1..] {
-            self.psi(sys, t_r, &mut z, 1, stats)?;
+        // Ψ depends on the phase only: each period starts at the phase of t.
+        for wk in &w[1..] {
+            self.psi(sys, t, &mut z, 1, stats)?;
             for (fi, zi) in f.iter_mut().zip(&z) {
-                *fi += wj * zi;
+                *fi += wk * zi;
             }
         }
         Ok(f)
@@ -234,12 +222,14 @@ impl Stroboscopic {
         };
         let mut ks: Vec<Vec<f64>> = vec![k1.to_vec()];
         for row in 1..6 {
-            let z = stage(&A[row][..row], &ks);
+            let mut z = stage(&A[row][..row], &ks);
+            sys.settle_like(y, &mut z);
             ks.push(self.slope_at(sys, t, &z, stats).ok()?);
         }
         // The last row is the solution (first same as last): its slope starts the next step.
         let mut y_new = stage(&A[6][..6], &ks);
         sys.project(&mut y_new);
+        sys.settle_like(y, &mut y_new);
         check_state(sys, t + h, &y_new).ok()?;
         let k_new = self.slope_at(sys, t, &y_new, stats).ok()?;
         let err: Vec<f64> = (0..n)

@@ -19,6 +19,12 @@ pub trait OdeSystem {
     }
     /// Map a state back onto its manifold after a step (e.g. renormalise unit vectors).
     fn project(&self, _y: &mut [f64]) {}
+    /// Give the fast variables of `y` the values they have in `settled`, a state of the same
+    /// phase on the slow manifold (a spring's length, settled onto its stroke), keeping the slow
+    /// ones (positions, orientations). Stroboscopic averaging extrapolates slow motion; this
+    /// puts an extrapolated state back next to the manifold, so no period need relax it. A system
+    /// without fast variables (the default) has nothing to settle.
+    fn settle_like(&self, _settled: &[f64], _y: &mut [f64]) {}
     /// Size of the diagonal blocks of the approximate Jacobian [`OdeSystem::jacobian_blocks`]
     /// offers (0: none; linearly implicit methods then treat the system as non-stiff).
     fn jacobian_block(&self) -> usize {

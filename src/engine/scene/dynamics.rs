@@ -184,7 +184,8 @@ impl Scene {
     }
 
     /// A fresh stepper for `spec` on this scene. Stroboscopic averaging needs the common period,
-    /// the slowest spring relaxation (how many periods relax the fast motion) and a length scale.
+    /// the slowest spring relaxation (how many periods settle the springs after a start) and a
+    /// length scale.
     pub(crate) fn stepper(&self, spec: IntegratorSpec) -> Result<Box<dyn Stepper>> {
         self.check_noise(spec)?;
         if let Some(st) = spec.build() {
@@ -209,7 +210,8 @@ impl Scene {
         let inner_stepper = inner
             .build()
             .ok_or_else(|| invalid!("the inner integrator {inner} must be a direct method"))?;
-        let relax = match self.model {
+        // Periods integrated directly after a start, for the springs to settle from L(0).
+        let transient = match self.model {
             // The hydrodynamic interaction slows a spring's mode (bench stability: by < 2×).
             Model::Micro => {
                 let slowest = self
@@ -228,8 +230,7 @@ impl Scene {
             tol,
             period,
             inner_stepper,
-            relax,
-            relax,
+            transient,
             length,
         )))
     }
