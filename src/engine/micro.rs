@@ -285,3 +285,23 @@ impl OdeSystem for MicroSystem {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settling_keeps_centre_and_direction_and_takes_the_settled_length() {
+        let swimmers = vec![Dumbbell::default(); 2];
+        let base = vec![Vector3::zeros(); 2];
+        let sys = MicroSystem::new(&swimmers, &base, 1e-3, Mobility::Rpy, Contacts::default());
+        // Swimmer 0 stretched and turned, swimmer 1 compressed.
+        let settled = [1.0, 2.0, 3.0, 5.0, 0.0, 0.0, 4.0, 5.0, 6.0, 0.0, 8.0, 0.0];
+        let mut y = [1.5, 2.5, 3.5, 6.0, 8.0, 0.0, 4.0, 5.0, 6.0, 0.0, 0.0, 2.0];
+        sys.settle_like(&settled, &mut y);
+        assert_eq!(&y[0..3], &[1.5, 2.5, 3.5]);
+        assert_eq!(&y[3..6], &[3.0, 4.0, 0.0]);
+        assert_eq!(&y[6..9], &[4.0, 5.0, 6.0]);
+        assert_eq!(&y[9..12], &[0.0, 0.0, 8.0]);
+    }
+}
