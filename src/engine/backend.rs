@@ -4,7 +4,7 @@
 
 use super::choice::{self, Choice, Named};
 use super::gpu::rk_stages::Tableau;
-use super::integrators::IntegratorSpec;
+use super::integrators::{IntegratorSpec, DOPRI5_A, DOPRI5_C, DOPRI5_E};
 use super::model::Model;
 use serde::{Deserialize, Serialize};
 
@@ -44,17 +44,45 @@ impl Named for Backend {
 
 choice::inherent_names!(Backend);
 
+/// How the device steps: uniform steps of `dt`, or adaptive steps at relative tolerance `rtol`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GpuSteps {
+    /// Uniform steps (s).
+    Fixed(f64),
+    /// Error-controlled steps of an embedded pair.
+    Adaptive(f64),
+}
+
 /// The device Runge-Kutta method for an integrator, or why it has none.
-pub fn gpu_tableau(spec: &IntegratorSpec) -> std::result::Result<(f64, Tableau), String> {
+pub fn gpu_tableau(spec: &IntegratorSpec) -> std::result::Result<(GpuSteps, Tableau), String> {
     match *spec {
-        IntegratorSpec::Euler { dt } => Ok((dt, Tableau::euler())),
-        IntegratorSpec::Rk4 { dt } => Ok((dt, Tableau::rk4())),
+        IntegratorSpec::Euler { dt } => Ok((GpuSteps::Fixed(dt), Tableau::euler())),
+        IntegratorSpec::Rk4 { dt } => Ok((GpuSteps::Fixed(dt), Tableau::rk4())),
+        IntegratorSpec::Dopri5 { rtol } => Ok((GpuSteps::Adaptive(rtol), dopri5_tableau())),
         IntegratorSpec::Platen { .. } => Err(format!(
-            "the GPU backend steps the fixed-step methods euler(dt) and rk4(dt); {spec}, the weak scheme for thermal noise, runs on the CPU"
+            "the GPU backend steps euler(dt), rk4(dt) and dopri5(rtol); {spec}, the weak scheme for thermal noise, runs on the CPU"
         )),
         other => Err(format!(
-            "the GPU backend steps the fixed-step methods euler(dt) and rk4(dt); {other} is adaptive and runs on the CPU"
+            "the GPU backend steps euler(dt), rk4(dt) and dopri5(rtol); {other} runs on the CPU"
         )),
+    }
+}
+
+/// The CPU's Dormand-Prince 5(4) tableau, for the device.
+fn dopri5_tableau() -> Tableau {
+    let a: Vec<Vec<f64>> = DOPRI5_A
+        .iter()
+        .enumerate()
+        .map(|(s, row)| row[..s].to_vec())
+        .collect();
+    // The last row is the solution; its stage (taken there) has weight 0.
+    let mut b = DOPRI5_A[6].to_vec();
+    b.push(0.0);
+    Tableau {
+        c: DOPRI5_C.to_vec(),
+        a,
+        b,
+        e: DOPRI5_E.to_vec(),
     }
 }
 

@@ -6,8 +6,9 @@
 //! the calibration of "auto" steps both backends through here.
 
 use super::backend;
+use super::backend::GpuSteps;
 use super::error::{invalid, unsupported, EngineError, Result, Setting};
-use super::gpu::{GpuModel, GpuRun, RunOutcome, UniformSteps};
+use super::gpu::{AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
 use super::integrators::{uniform_steps, IntegratorSpec, Stepper};
 use super::model::Model;
 use super::scene::Scene;
@@ -149,16 +150,18 @@ pub fn advance_cpu(
     outcome
 }
 
-/// Step `s` to `t_end` on the GPU: uniform steps as the CPU stepper takes them. A step whose
-/// state fails a guard on the device is replayed on the CPU, which either reports it exactly as
-/// the CPU backend does or (a borderline case decided differently by rounding) takes it.
+/// Step `s` to `t_end` on the GPU, taking the steps the CPU stepper takes: uniform ones, or
+/// dopri5's adaptive ones (error norm, accept/reject and the next step decided on the device).
+/// A step whose state fails a guard on the device is replayed on the CPU, which either reports
+/// it exactly as the CPU backend does or (a borderline case decided differently by rounding)
+/// takes it.
 pub fn advance_gpu(
     s: &mut Scene,
     ws: &mut Workspace,
     control: &RunControl,
     t_end: f64,
 ) -> Result<()> {
-    let (dt, tableau) = backend::gpu_tableau(&s.integrator()).map_err(|e| invalid!("{e}"))?;
+    let (steps, tableau) = backend::gpu_tableau(&s.integrator()).map_err(|e| invalid!("{e}"))?;
     let model = match s.model() {
         Model::Micro => GpuModel::Micro {
             mu: s.mu(),
@@ -176,11 +179,39 @@ pub fn advance_gpu(
         Some(r) if r.fits(model, s.count(), &tableau) => r,
         _ => GpuRun::new(model, s.count(), tableau.clone()).map_err(|e| invalid!("{e}"))?,
     };
-    let stages = tableau.stages() as u64;
+    let result = match steps {
+        GpuSteps::Fixed(dt) => uniform_on_gpu(s, ws, control, t_end, &mut run, dt),
+        GpuSteps::Adaptive(rtol) => adaptive_on_gpu(s, ws, control, t_end, &mut run, rtol),
+    };
+    ws.gpu = Some(run);
+    result
+}
+
+/// A device run that failed as a whole (lost device, out of memory).
+fn device_failed(e: String, s: &Scene) -> EngineError {
+    unsupported(
+        format!(
+            "the GPU run failed: {e}; the scene keeps its state at t = {:.6e} s",
+            s.time
+        ),
+        &[Setting::Backend("cpu")],
+    )
+}
+
+/// Uniform steps of `dt` on the device.
+fn uniform_on_gpu(
+    s: &mut Scene,
+    ws: &mut Workspace,
+    control: &RunControl,
+    t_end: f64,
+    run: &mut GpuRun,
+    dt: f64,
+) -> Result<()> {
+    let stages = run.stages() as u64;
     let interrupted = || control.interrupted();
-    let result = loop {
+    loop {
         if s.time >= t_end {
-            break Ok(());
+            return Ok(());
         }
         let (n, h) = uniform_steps(s.time, t_end, dt);
         let t0 = s.time;
@@ -191,18 +222,10 @@ pub fn advance_gpu(
             UniformSteps { t0, h, count: n },
             &interrupted,
         );
+        let outcome = outcome.map_err(|e| device_failed(e, s))?;
         let done = match outcome {
-            Err(e) => {
-                break Err(unsupported(
-                    format!(
-                        "the GPU run failed: {e}; the scene keeps its state at t = {:.6e} s",
-                        s.time
-                    ),
-                    &[Setting::Backend("cpu")],
-                ))
-            }
-            Ok(RunOutcome::Done) => n,
-            Ok(RunOutcome::Failed { steps_done }) | Ok(RunOutcome::Interrupted { steps_done }) => {
+            RunOutcome::Done => n,
+            RunOutcome::Failed { steps_done } | RunOutcome::Interrupted { steps_done } => {
                 steps_done
             }
         };
@@ -215,18 +238,89 @@ pub fn advance_gpu(
         s.stats.rhs_evals += done * stages + 1;
         control.report(s.time);
         match outcome {
-            Ok(RunOutcome::Interrupted { .. }) => {
-                break Err(EngineError::Interrupted { time: s.time })
+            RunOutcome::Interrupted { .. } => {
+                return Err(EngineError::Interrupted { time: s.time })
             }
-            Ok(RunOutcome::Failed { .. }) => {
-                // One step on the CPU: the same step, checked by the same guards.
-                if let Err(e) = advance_cpu(s, ws, control, t_end, 1) {
+            // One step on the CPU: the same step, checked by the same guards.
+            RunOutcome::Failed { .. } => advance_cpu(s, ws, control, t_end, 1)?,
+            RunOutcome::Done => {}
+        }
+    }
+}
+
+/// Adaptive steps at `rtol` on the device. The CPU stepper (cached in the workspace as for a CPU
+/// run, and reset as a CPU run resets it) keeps the step size between runs and gives the first
+/// one; the device takes the steps; a failing step is replayed on the CPU from the step size it
+/// began with.
+fn adaptive_on_gpu(
+    s: &mut Scene,
+    ws: &mut Workspace,
+    control: &RunControl,
+    t_end: f64,
+    run: &mut GpuRun,
+    rtol: f64,
+) -> Result<()> {
+    let spec = s.integrator();
+    let key = s.stepper_key(spec);
+    let mut sys = s.system()?;
+    let mut stepper = match ws.stepper.take() {
+        Some((cached, cached_key, mut st)) if cached == spec && cached_key == key => {
+            st.reset();
+            st
+        }
+        _ => s.stepper(spec)?,
+    };
+    let mut scale = vec![0.0; s.state.len()];
+    sys.error_scale(&s.state, &mut scale);
+    let stages = run.stages() as u64 - 1;
+    let interrupted = || control.interrupted();
+    let result = loop {
+        if s.time >= t_end {
+            break Ok(());
+        }
+        let Some(h) = stepper.next_step(sys.as_mut(), s.time, &s.state, &mut s.stats) else {
+            break Err(invalid!("{spec} takes no adaptive steps"));
+        };
+        let report = run.run_adaptive(
+            &s.swimmers,
+            &s.base,
+            &mut s.state,
+            &scale,
+            AdaptiveSteps {
+                t0: s.time,
+                t_end,
+                h,
+                rtol,
+            },
+            &interrupted,
+        );
+        let report = match report {
+            Ok(r) => r,
+            Err(e) => break Err(device_failed(e, s)),
+        };
+        s.time = report.t;
+        s.stats.steps += report.steps;
+        s.stats.rejected += report.rejected;
+        s.stats.rhs_evals += stages * (report.steps + report.rejected) + 1;
+        stepper.continue_with_step(report.h);
+        control.report(s.time);
+        match report.outcome {
+            RunOutcome::Interrupted { .. } => break Err(EngineError::Interrupted { time: s.time }),
+            RunOutcome::Failed { .. } => {
+                // The failing step on the CPU, from the step size it began with.
+                ws.stepper = Some((spec, key.clone(), stepper));
+                let replay = advance_cpu(s, ws, control, t_end, 1);
+                stepper = match ws.stepper.take() {
+                    Some((_, _, st)) => st,
+                    None => s.stepper(spec)?,
+                };
+                if let Err(e) = replay {
                     break Err(e);
                 }
             }
-            _ => {}
+            RunOutcome::Done => {}
         }
     };
-    ws.gpu = Some(run);
+    ws.stepper = Some((spec, key, stepper));
     result
 }

@@ -19,7 +19,7 @@ var<workgroup> halt: u32;
 @compute @workgroup_size(64)
 fn interact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
     if lid.x == 0u {
-        halt = atomicLoad(&control.failed);
+        halt = select(NONE, 0u, stopped());
     }
     if workgroupUniformLoad(&halt) != NONE {
         return;

@@ -5,26 +5,54 @@
 // coefficients of one Runge-Kutta stage (one small buffer per stage, bound per dispatch).
 
 struct Params {
-    // Start of the run (s) and the uniform step (s): stage time = t0 + (step + c) h.
+    // Start of the run (s) and the uniform step (s): stage time = t0 + (step + c) h (uniform runs).
     t0: f64,
     h: f64,
     // 1/(8πμ) and 1/(24πμ): the Oseen and finite-size prefactors of the RPY tensor.
     oseen: f64,
     rpy: f64,
+    // Adaptive runs: the relative tolerance of the error norm.
+    rtol: f64,
     // Number of swimmers, state length (6 n), 1 for RPY (0: Oseen), 1 to renormalise N after a step.
     n: u32,
     nstate: u32,
     use_rpy: u32,
     project: u32,
+    // 1: adaptive steps, their time and size in `control`; 0: uniform steps.
+    adaptive: u32,
+    pad: u32,
 }
 
 struct Control {
-    // Steps committed since t0.
+    // Steps committed since the start of the run.
     step: u32,
     // NONE, or 4 × swimmer + code of the first problem found (CODE_*); every kernel stops once set.
     failed: atomic<u32>,
+    // Adaptive runs (rk_stages.wgsl): attempts rejected since the start; 1 once t reached t_end
+    // (every kernel stops); 1 if the last attempt was accepted; whether the attempt before this
+    // one (of the same step) was rejected; consecutive rejections of this step; 1 if this
+    // attempt is clipped to land on t_end.
+    rejected: u32,
+    done: u32,
+    accepted: u32,
+    rejected_last: u32,
+    rejects: u32,
+    last: u32,
+    // Adaptive runs: the first problem the guards found at this attempt's solution (as
+    // `failed`); it fails the run only if the attempt is accepted, as the CPU checks accepted
+    // steps only.
+    guard: atomic<u32>,
     pad0: u32,
-    pad1: u32,
+    // Time of y (s), end of the run (s), the step to try next (s), this attempt's step (s), the
+    // step proposed when this step began (a failing step is replayed on the CPU from it), the
+    // PI controller's previous error, and the last error norm.
+    t: f64,
+    t_end: f64,
+    h: f64,
+    h_try: f64,
+    h_start: f64,
+    fac_old: f64,
+    err: f64,
 }
 
 // One Runge-Kutta stage: y_stage = src + h Σ_{j<nk} a_j k_j at time t0 + (step + c) h, its rates
@@ -42,6 +70,8 @@ const NONE: u32 = 0xffffffffu;
 const CODE_NOT_FINITE: u32 = 1u;
 const CODE_SPRING: u32 = 2u;
 const CODE_CONTACT: u32 = 3u;
+// An adaptive step rejected MAX_REJECTS times in a row (rk_stages.wgsl).
+const CODE_TOLERANCE: u32 = 0u;
 const WG: u32 = 64u;
 
 @group(0) @binding(0) var<storage, read> params: Params;
@@ -54,18 +84,37 @@ const WG: u32 = 64u;
 @group(0) @binding(6) var<storage, read> swimmers: array<f64>;
 // Per sphere: (x, y, z, radius), (force, 0). Microscopic model only.
 @group(0) @binding(7) var<storage, read_write> spheres: array<vec4<f64>>;
+// Adaptive runs: the error scale of each state component (nstate), then each swimmer's sum of
+// squared scaled errors (n).
+@group(0) @binding(8) var<storage, read_write> adapt: array<f64>;
 @group(1) @binding(0) var<storage, read> stage: Stage;
 
 fn fail(swimmer: u32, code: u32) {
-    atomicMin(&control.failed, swimmer * 4u + code);
+    if params.adaptive == 1u && stage.check == 1u {
+        atomicMin(&control.guard, swimmer * 4u + code);
+    } else {
+        atomicMin(&control.failed, swimmer * 4u + code);
+    }
 }
 
+// A guard fired, or an adaptive run reached its end.
 fn stopped() -> bool {
-    return atomicLoad(&control.failed) != NONE;
+    return atomicLoad(&control.failed) != NONE || control.done != 0u;
 }
 
 fn stage_time() -> f64 {
+    if params.adaptive == 1u {
+        return control.t + stage.c * control.h_try;
+    }
     return params.t0 + (f64(control.step) + stage.c) * params.h;
+}
+
+// The step of the stage being taken.
+fn step_size() -> f64 {
+    if params.adaptive == 1u {
+        return control.h_try;
+    }
+    return params.h;
 }
 
 fn state3(s: u32, offset: u32) -> vec3<f64> {

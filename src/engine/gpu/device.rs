@@ -12,7 +12,7 @@
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Storage buffers each kernel binds (groups 0 and 1 of common.wgsl).
-const STORAGE_BUFFERS: u32 = 9;
+const STORAGE_BUFFERS: u32 = 10;
 
 /// An acquired device with the limits the kernels need.
 pub struct GpuDevice {

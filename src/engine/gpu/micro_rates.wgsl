@@ -33,13 +33,34 @@ fn place(@builtin(global_invocation_id) gid: vec3<u32>) {
     spheres[4u * s + 3u] = vec4<f64>(-f, 0.0lf);
 }
 
+// The RPY tensor of overlapping spheres (Zuk et al. 2014) applied to f; 1/(6πμ) = (4/3)/(8πμ).
+fn overlap_apply(r: vec3<f64>, r2: f64, ai: f64, aj: f64, f: vec3<f64>) -> vec3<f64> {
+    let d = sqrt(r2);
+    let stokes = 4.0lf / 3.0lf * params.oseen;
+    if d <= abs(ai - aj) {
+        return stokes / max(ai, aj) * f;
+    }
+    let dm = (ai - aj) * (ai - aj);
+    let d3 = d * d * d;
+    let scale = stokes / (32.0lf * d3 * ai * aj);
+    let b = dm + 3.0lf * r2;
+    let ci = (16.0lf * d3 * (ai + aj) - b * b) * scale;
+    let crr = 3.0lf * (dm - r2) * (dm - r2) * scale;
+    return ci * f + r * (crr * dot(r, f) / r2);
+}
+
 var<workgroup> tile_pos: array<vec4<f64>, WG>;
 var<workgroup> tile_force: array<vec4<f64>, WG>;
 var<workgroup> halt: u32;
 
-// H_ij f for spheres at separation r = x_i − x_j with radii ai, aj (Mazur's RPY or Oseen).
+// H_ij f for spheres at separation r = x_i − x_j with radii ai, aj (Mazur's RPY or Oseen; for
+// overlapping spheres the RPY overlap forms, as Mobility::pair_coefficients on the CPU: a stage
+// state of a rejected attempt may press a dumbbell's own spheres together).
 fn pair_apply(r: vec3<f64>, ai: f64, aj: f64, f: vec3<f64>) -> vec3<f64> {
     let r2 = dot(r, r);
+    if params.use_rpy == 1u && r2 <= (ai + aj) * (ai + aj) {
+        return overlap_apply(r, r2, ai, aj, f);
+    }
     let inv_r = 1.0lf / sqrt(r2);
     let rdf = dot(r, f) * inv_r * inv_r;
     var out = (params.oseen * inv_r) * (f + r * rdf);
@@ -54,7 +75,7 @@ fn pair_apply(r: vec3<f64>, ai: f64, aj: f64, f: vec3<f64>) -> vec3<f64> {
 @compute @workgroup_size(64)
 fn interact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
     if lid.x == 0u {
-        halt = atomicLoad(&control.failed);
+        halt = select(NONE, 0u, stopped());
     }
     if workgroupUniformLoad(&halt) != NONE {
         return;

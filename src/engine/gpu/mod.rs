@@ -23,7 +23,7 @@ pub mod rk_stages;
 pub mod runner;
 
 pub use device::{available, device, GpuDevice};
-pub use runner::{GpuModel, GpuRun, RunOutcome, UniformSteps};
+pub use runner::{AdaptiveReport, AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
 
 use std::sync::{Arc, OnceLock};
 
@@ -65,8 +65,9 @@ fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
 fn compile(dev: &GpuDevice) -> Result<Kernels, String> {
     let d = &dev.device;
     let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-    // Group 0 as declared in common.wgsl: params, y, y_new, y_stage, k, control, swimmers, spheres.
-    let read_only = [true, false, false, false, false, false, true, false];
+    // Group 0 as declared in common.wgsl: params, y, y_new, y_stage, k, control, swimmers, spheres,
+    // adapt.
+    let read_only = [true, false, false, false, false, false, true, false, false];
     let entries: Vec<_> = read_only
         .iter()
         .enumerate()

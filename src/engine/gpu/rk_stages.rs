@@ -1,6 +1,7 @@
 //! Explicit Runge-Kutta stages on the device (rk_stages.wgsl): the stage states, the combination
-//! of a step, and the commit that accepts it unless a guard fired. The tableaux are those of the
-//! CPU steppers, so both backends take the same steps.
+//! of a step, and the commit that accepts it unless a guard fired; for an embedded pair
+//! (Dormand-Prince 5(4)) the error norm, accept/reject and the next step size. The tableaux are
+//! those of the CPU steppers, so both backends take the same steps.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -12,6 +13,10 @@ pub struct Pipelines {
     pub(crate) stage_state: wgpu::ComputePipeline,
     pub(crate) combine: wgpu::ComputePipeline,
     pub(crate) commit: wgpu::ComputePipeline,
+    pub(crate) begin_attempt: wgpu::ComputePipeline,
+    pub(crate) error_part: wgpu::ComputePipeline,
+    pub(crate) decide: wgpu::ComputePipeline,
+    pub(crate) commit_attempt: wgpu::ComputePipeline,
 }
 
 impl Pipelines {
@@ -21,6 +26,10 @@ impl Pipelines {
             stage_state: super::pipeline(d, layout, &m, "stage_state"),
             combine: super::pipeline(d, layout, &m, "combine"),
             commit: super::pipeline(d, layout, &m, "commit"),
+            begin_attempt: super::pipeline(d, layout, &m, "begin_attempt"),
+            error_part: super::pipeline(d, layout, &m, "error_part"),
+            decide: super::pipeline(d, layout, &m, "decide"),
+            commit_attempt: super::pipeline(d, layout, &m, "commit_attempt"),
         }
     }
 }
@@ -43,7 +52,8 @@ pub struct StageParams {
     pub check: u32,
 }
 
-/// An explicit Runge-Kutta method: stage times `c`, stage matrix rows `a`, weights `b`.
+/// An explicit Runge-Kutta method: stage times `c`, stage matrix rows `a`, weights `b`, and for
+/// an embedded pair the error weights `e`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tableau {
     /// c_s, s = 0..S (c_0 = 0).
@@ -52,6 +62,10 @@ pub struct Tableau {
     pub a: Vec<Vec<f64>>,
     /// b_j.
     pub b: Vec<f64>,
+    /// Empty for a fixed-step method. For an embedded pair whose last stage is taken at the
+    /// solution (a_Sj = b_j: first same as last): the solution minus the embedded one, e_j, over
+    /// all S stages. Such a method runs adaptively.
+    pub e: Vec<f64>,
 }
 
 impl Tableau {
@@ -61,6 +75,7 @@ impl Tableau {
             c: vec![0.0],
             a: vec![vec![]],
             b: vec![1.0],
+            e: Vec::new(),
         }
     }
 
@@ -70,6 +85,7 @@ impl Tableau {
             c: vec![0.0, 0.5, 0.5, 1.0],
             a: vec![vec![], vec![0.5], vec![0.0, 0.5], vec![0.0, 0.0, 1.0]],
             b: vec![1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0],
+            e: Vec::new(),
         }
     }
 
@@ -78,15 +94,25 @@ impl Tableau {
         self.b.len()
     }
 
+    /// Whether the method runs adaptively (an embedded pair).
+    pub fn is_adaptive(&self) -> bool {
+        !self.e.is_empty()
+    }
+
     fn coefficients(v: &[f64]) -> [f64; 8] {
         let mut a = [0.0; 8];
         a[..v.len()].copy_from_slice(v);
         a
     }
 
-    /// The stage parameters: stages 1..S, then the combination, then the check pass at y_new
-    /// (whose rates are k_0 of the next step), then stage 0 at y (to start a run).
+    /// The stage parameters. Fixed steps: stages 1..S, then the combination, then the check pass
+    /// at y_new (whose rates are k_0 of the next step), then stage 0 at y (to start a run).
+    /// Adaptive: stages 1..S (the last, at the solution, checked by the guards), then the error
+    /// weights, then stage 0 at y.
     pub(crate) fn stage_params(&self) -> Vec<StageParams> {
+        if self.is_adaptive() {
+            return self.adaptive_stage_params();
+        }
         let s = self.stages();
         let mut out: Vec<StageParams> = (1..s)
             .map(|i| StageParams {
@@ -114,14 +140,43 @@ impl Tableau {
             nk: 0,
             check: 1,
         });
-        out.push(StageParams {
+        out.push(Self::start());
+        out
+    }
+
+    /// Stage 0 at y: the rates that start a run.
+    fn start() -> StageParams {
+        StageParams {
             a: [0.0; 8],
             c: 0.0,
             src: 0,
             out: 0,
             nk: 0,
             check: 0,
+        }
+    }
+
+    fn adaptive_stage_params(&self) -> Vec<StageParams> {
+        let s = self.stages();
+        let mut out: Vec<StageParams> = (1..s)
+            .map(|i| StageParams {
+                a: Self::coefficients(&self.a[i]),
+                c: self.c[i],
+                src: 0,
+                out: i as u32,
+                nk: i as u32,
+                check: u32::from(i == s - 1),
+            })
+            .collect();
+        out.push(StageParams {
+            a: Self::coefficients(&self.e),
+            c: 1.0,
+            src: 0,
+            out: 0,
+            nk: s as u32,
+            check: 0,
         });
+        out.push(Self::start());
         out
     }
 }

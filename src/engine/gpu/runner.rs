@@ -55,6 +55,35 @@ pub struct UniformSteps {
     pub count: u64,
 }
 
+/// Adaptive steps from `t0` to `t_end`, trying `h` first, at relative tolerance `rtol` (the
+/// method is the buffers' embedded tableau).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdaptiveSteps {
+    /// Start time (s).
+    pub t0: f64,
+    /// End time (s).
+    pub t_end: f64,
+    /// The step to try first (s).
+    pub h: f64,
+    /// Relative tolerance of the error norm.
+    pub rtol: f64,
+}
+
+/// Where an adaptive run on the device stopped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdaptiveReport {
+    /// How it ended (`steps_done`: accepted steps).
+    pub outcome: RunOutcome,
+    /// The time of the state read back (s).
+    pub t: f64,
+    /// The step to try next (s); after a failure, the one the failing step began with.
+    pub h: f64,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected attempts (after a failure: not counting the failing step's).
+    pub rejected: u64,
+}
+
 /// `struct Params` of common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -63,10 +92,13 @@ struct Params {
     h: f64,
     oseen: f64,
     rpy: f64,
+    rtol: f64,
     n: u32,
     nstate: u32,
     use_rpy: u32,
     project: u32,
+    adaptive: u32,
+    pad: u32,
 }
 
 /// `struct Control` of common.wgsl.
@@ -75,7 +107,37 @@ struct Params {
 struct Control {
     step: u32,
     failed: u32,
-    pad: [u32; 2],
+    rejected: u32,
+    done: u32,
+    accepted: u32,
+    rejected_last: u32,
+    rejects: u32,
+    last: u32,
+    guard: u32,
+    pad0: u32,
+    t: f64,
+    t_end: f64,
+    h: f64,
+    h_try: f64,
+    h_start: f64,
+    fac_old: f64,
+    err: f64,
+}
+
+impl Control {
+    /// A fresh control block: no step taken, no failure; adaptive runs start at (t, h) towards
+    /// t_end with the controller's initial previous error (the CPU's Dopri5 after a reset).
+    fn start(t: f64, t_end: f64, h: f64) -> Self {
+        Control {
+            failed: NONE,
+            guard: NONE,
+            t,
+            t_end,
+            h,
+            fac_old: 1e-4,
+            ..Zeroable::zeroed()
+        }
+    }
 }
 
 const NONE: u32 = u32::MAX;
@@ -97,6 +159,7 @@ pub struct GpuRun {
     y: wgpu::Buffer,
     control: wgpu::Buffer,
     swimmers: wgpu::Buffer,
+    adapt: wgpu::Buffer,
     group0: wgpu::BindGroup,
     /// Bind groups of [`Tableau::stage_params`], in that order.
     stages: Vec<wgpu::BindGroup>,
@@ -154,8 +217,14 @@ impl GpuRun {
             GpuModel::Micro { .. } => storage(&dev, "spheres", f64s(16 * n)),
             GpuModel::Averaged { .. } => storage(&dev, "spheres (unused)", 32),
         };
+        // Error scales and per-swimmer error sums of an adaptive method.
+        let adapt = if tableau.is_adaptive() {
+            storage(&dev, "adapt", f64s(nstate + n))
+        } else {
+            storage(&dev, "adapt (unused)", 32)
+        };
         let buffers = [
-            &params, &y, &y_new, &y_stage, &k, &control, &swimmers, &spheres,
+            &params, &y, &y_new, &y_stage, &k, &control, &swimmers, &spheres, &adapt,
         ];
         let entries: Vec<_> = buffers
             .iter()
@@ -203,6 +272,7 @@ impl GpuRun {
             y,
             control,
             swimmers,
+            adapt,
             group0,
             stages,
             read_state,
@@ -214,6 +284,11 @@ impl GpuRun {
     /// Whether these buffers serve `n` swimmers of `model` with `tableau`.
     pub fn fits(&self, model: GpuModel, n: usize, tableau: &Tableau) -> bool {
         self.model == model && self.n == n && &self.tableau == tableau
+    }
+
+    /// Stages of the buffers' method.
+    pub fn stages(&self) -> usize {
+        self.tableau.stages()
     }
 
     /// The device these buffers live on.
@@ -238,18 +313,7 @@ impl GpuRun {
             h,
             count: steps,
         } = steps;
-        let constants = match self.model {
-            GpuModel::Micro { mu, .. } => super::micro_rates::pack(swimmers, base, mu),
-            GpuModel::Averaged { coefficients } => {
-                super::averaged_rates::pack(swimmers, base, coefficients)
-            }
-        };
-        self.dev
-            .queue
-            .write_buffer(&self.swimmers, 0, bytemuck::cast_slice(&constants));
-        self.dev
-            .queue
-            .write_buffer(&self.y, 0, bytemuck::cast_slice(y));
+        self.upload(swimmers, base, y);
         let mut done = 0u64;
         let mut outcome = RunOutcome::Done;
         while done < steps {
@@ -276,13 +340,24 @@ impl GpuRun {
         Ok(outcome)
     }
 
-    fn run_part(
-        &mut self,
-        t0: f64,
-        h: f64,
-        steps: u64,
-        interrupted: &dyn Fn() -> bool,
-    ) -> Result<RunOutcome, String> {
+    /// The swimmers' constants and the state go up.
+    fn upload(&self, swimmers: &[Dumbbell], base: &[Vector3<f64>], y: &[f64]) {
+        let constants = match self.model {
+            GpuModel::Micro { mu, .. } => super::micro_rates::pack(swimmers, base, mu),
+            GpuModel::Averaged { coefficients } => {
+                super::averaged_rates::pack(swimmers, base, coefficients)
+            }
+        };
+        self.dev
+            .queue
+            .write_buffer(&self.swimmers, 0, bytemuck::cast_slice(&constants));
+        self.dev
+            .queue
+            .write_buffer(&self.y, 0, bytemuck::cast_slice(y));
+    }
+
+    /// The run's parameters: uniform steps of `h` from `t0`, or (`rtol` > 0) adaptive steps.
+    fn params(&self, t0: f64, h: f64, rtol: f64) -> Params {
         let (oseen, rpy, use_rpy, project) = match self.model {
             GpuModel::Micro { mu, mobility } => (
                 1.0 / (8.0 * std::f64::consts::PI * mu),
@@ -292,23 +367,32 @@ impl GpuRun {
             ),
             GpuModel::Averaged { .. } => (0.0, 0.0, 0, 1),
         };
-        let params = Params {
+        Params {
             t0,
             h,
             oseen,
             rpy,
+            rtol,
             n: self.n as u32,
             nstate: (STATE_PER_SWIMMER * self.n) as u32,
             use_rpy,
             project,
-        };
+            adaptive: u32::from(rtol > 0.0),
+            pad: 0,
+        }
+    }
+
+    fn run_part(
+        &mut self,
+        t0: f64,
+        h: f64,
+        steps: u64,
+        interrupted: &dyn Fn() -> bool,
+    ) -> Result<RunOutcome, String> {
+        let params = self.params(t0, h, 0.0);
         let q = &self.dev.queue;
         q.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let control = Control {
-            step: 0,
-            failed: NONE,
-            pad: [0; 2],
-        };
+        let control = Control::start(t0, t0, h);
         q.write_buffer(&self.control, 0, bytemuck::bytes_of(&control));
         let mut done = 0u64;
         let mut first = true;
@@ -328,11 +412,145 @@ impl GpuRun {
                 });
             }
             done += m;
-            let scale = (TARGET_SUBMISSION_SECONDS / elapsed).clamp(0.5, 4.0);
-            self.steps_per_submission =
-                ((m as f64 * scale) as u64).clamp(1, MAX_STEPS_PER_SUBMISSION);
+            self.pace(m, elapsed);
         }
         Ok(RunOutcome::Done)
+    }
+
+    /// Size the next submission from how long `m` steps took.
+    fn pace(&mut self, m: u64, elapsed: f64) {
+        let scale = (TARGET_SUBMISSION_SECONDS / elapsed).clamp(0.5, 4.0);
+        self.steps_per_submission = ((m as f64 * scale) as u64).clamp(1, MAX_STEPS_PER_SUBMISSION);
+    }
+
+    /// Adaptive steps of the buffers' embedded tableau from (t0, y) to t_end, error-controlled
+    /// against the per-component `scale` ([`crate::engine::integrators::OdeSystem::error_scale`]):
+    /// the error norm is reduced, the step accepted or rejected and the next one chosen on the
+    /// device, so a submission holds many attempts and only the control block comes back between
+    /// them. `y` comes back at the end, after a guard fired (the last accepted state) or an
+    /// interrupt. Fewer than 2^30 steps are taken per call; the caller goes on from the time
+    /// reported.
+    pub fn run_adaptive(
+        &mut self,
+        swimmers: &[Dumbbell],
+        base: &[Vector3<f64>],
+        y: &mut [f64],
+        scale: &[f64],
+        steps: AdaptiveSteps,
+        interrupted: &dyn Fn() -> bool,
+    ) -> Result<AdaptiveReport, String> {
+        if !self.tableau.is_adaptive() {
+            return Err("these device buffers hold a fixed-step method".into());
+        }
+        self.upload(swimmers, base, y);
+        let q = &self.dev.queue;
+        q.write_buffer(&self.adapt, 0, bytemuck::cast_slice(scale));
+        let params = self.params(steps.t0, 0.0, steps.rtol);
+        q.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let control = Control::start(steps.t0, steps.t_end, steps.h);
+        q.write_buffer(&self.control, 0, bytemuck::bytes_of(&control));
+        let mut first = true;
+        let (c, outcome) = loop {
+            let m = self.steps_per_submission;
+            let started = Instant::now();
+            self.submit_attempts(m, first);
+            first = false;
+            let c = self.read_control()?;
+            self.pace(m, started.elapsed().as_secs_f64().max(1e-6));
+            let steps_done = u64::from(c.step);
+            if c.failed != NONE {
+                break (c, RunOutcome::Failed { steps_done });
+            }
+            if c.done != 0 || steps_done >= MAX_STEPS_PER_COUNTER {
+                break (c, RunOutcome::Done);
+            }
+            if interrupted() {
+                break (c, RunOutcome::Interrupted { steps_done });
+            }
+        };
+        self.read_state(y)?;
+        let failed = matches!(outcome, RunOutcome::Failed { .. });
+        Ok(AdaptiveReport {
+            outcome,
+            t: c.t,
+            h: if failed { c.h_start } else { c.h },
+            steps: u64::from(c.step),
+            rejected: u64::from(if failed {
+                c.rejected - c.rejects
+            } else {
+                c.rejected
+            }),
+        })
+    }
+
+    /// Encode and submit `m` adaptive attempts (and, on a run's first submission, the rates at
+    /// the start); attempts after the run's end or a failure return at once.
+    fn submit_attempts(&self, m: u64, first: bool) {
+        let groups = (self.n as u32).div_ceil(WORKGROUP);
+        let s = self.tableau.stages();
+        // Bind groups in the order of Tableau::stage_params: rows 1..S, error weights, start.
+        let (error, start) = (s - 1, s);
+        let mut enc = self
+            .dev
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("attempts"),
+            });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("attempts"),
+                timestamp_writes: None,
+            });
+            pass.set_bind_group(0, &self.group0, &[]);
+            let k = &self.kernels;
+            // Every pipeline's layout has group 1; begin_attempt reads no stage.
+            pass.set_bind_group(1, &self.stages[start], &[]);
+            if first {
+                self.encode_rates(&mut pass, start, groups);
+            }
+            for _ in 0..m {
+                pass.set_pipeline(&k.stages.begin_attempt);
+                pass.dispatch_workgroups(1, 1, 1);
+                for stage in 0..s - 1 {
+                    self.encode_rates(&mut pass, stage, groups);
+                }
+                pass.set_bind_group(1, &self.stages[error], &[]);
+                pass.set_pipeline(&k.stages.error_part);
+                pass.dispatch_workgroups(groups, 1, 1);
+                pass.set_pipeline(&k.stages.decide);
+                pass.dispatch_workgroups(1, 1, 1);
+                pass.set_pipeline(&k.stages.commit_attempt);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+        }
+        enc.copy_buffer_to_buffer(
+            &self.control,
+            0,
+            &self.read_control,
+            0,
+            std::mem::size_of::<Control>() as u64,
+        );
+        self.dev.queue.submit([enc.finish()]);
+    }
+
+    /// The stage state of bind group `stage` and the model's rates there.
+    fn encode_rates(&self, pass: &mut wgpu::ComputePass<'_>, stage: usize, groups: u32) {
+        let k = &self.kernels;
+        pass.set_bind_group(1, &self.stages[stage], &[]);
+        pass.set_pipeline(&k.stages.stage_state);
+        pass.dispatch_workgroups(groups, 1, 1);
+        match self.model {
+            GpuModel::Micro { .. } => {
+                pass.set_pipeline(&k.micro.place);
+                pass.dispatch_workgroups(groups, 1, 1);
+                pass.set_pipeline(&k.micro.interact);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+            GpuModel::Averaged { .. } => {
+                pass.set_pipeline(&k.averaged.interact);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+        }
     }
 
     /// Encode and submit `m` steps (and, on a run's first submission, the rates at the start).
@@ -354,35 +572,18 @@ impl GpuRun {
             });
             pass.set_bind_group(0, &self.group0, &[]);
             let k = &self.kernels;
-            let rates = |pass: &mut wgpu::ComputePass<'_>, stage: usize| {
-                pass.set_bind_group(1, &self.stages[stage], &[]);
-                pass.set_pipeline(&k.stages.stage_state);
-                pass.dispatch_workgroups(groups, 1, 1);
-                match self.model {
-                    GpuModel::Micro { .. } => {
-                        pass.set_pipeline(&k.micro.place);
-                        pass.dispatch_workgroups(groups, 1, 1);
-                        pass.set_pipeline(&k.micro.interact);
-                        pass.dispatch_workgroups(groups, 1, 1);
-                    }
-                    GpuModel::Averaged { .. } => {
-                        pass.set_pipeline(&k.averaged.interact);
-                        pass.dispatch_workgroups(groups, 1, 1);
-                    }
-                }
-            };
             if first {
-                rates(&mut pass, start);
+                self.encode_rates(&mut pass, start, groups);
             }
             for _ in 0..m {
                 for stage in 0..s - 1 {
-                    rates(&mut pass, stage);
+                    self.encode_rates(&mut pass, stage, groups);
                 }
                 pass.set_bind_group(1, &self.stages[combine], &[]);
                 pass.set_pipeline(&k.stages.combine);
                 pass.dispatch_workgroups(groups, 1, 1);
                 // The rates at y_new: the guards' contact test, and k_0 of the next step.
-                rates(&mut pass, check);
+                self.encode_rates(&mut pass, check, groups);
                 pass.set_pipeline(&k.stages.commit);
                 pass.dispatch_workgroups(groups, 1, 1);
             }

@@ -3,8 +3,10 @@
 
 use super::system::{check_state, fit, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
 
-const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
-pub(super) const A: [[f64; 6]; 7] = [
+/// Stage times (the GPU backend takes the same tableau).
+pub const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
+/// Stage matrix; its last row is the fifth-order solution (first same as last).
+pub const A: [[f64; 6]; 7] = [
     [0.0; 6],
     [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
@@ -35,7 +37,7 @@ pub(super) const A: [[f64; 6]; 7] = [
     ],
 ];
 /// Fifth-order solution minus embedded fourth-order one.
-pub(super) const E: [f64; 7] = [
+pub const E: [f64; 7] = [
     71.0 / 57600.0,
     0.0,
     -71.0 / 16695.0,
@@ -263,5 +265,34 @@ impl Stepper for Dopri5 {
     fn reset(&mut self) {
         self.fsal_valid = false;
         self.fac_old = 1e-4;
+    }
+
+    fn next_step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        stats: &mut Stats,
+    ) -> Option<f64> {
+        if self.fixed.is_some() {
+            return None;
+        }
+        if self.h.is_none() {
+            let n = y.len();
+            let [k1, k2, ..] = &mut self.k;
+            fit(n, &mut [k1, k2, &mut self.tmp, &mut self.scale]);
+            sys.error_scale(y, &mut self.scale);
+            sys.rhs(t, y, &mut self.k[0]);
+            stats.rhs_evals += 1;
+            self.h = Some(self.initial_step(sys, t, y, stats));
+            // The second stage slot was overwritten: the rates at y are recomputed by whoever steps.
+            self.fsal_valid = false;
+        }
+        self.h
+    }
+
+    fn continue_with_step(&mut self, h: f64) {
+        self.h = Some(h);
+        self.fsal_valid = false;
     }
 }

@@ -18,6 +18,8 @@ mod stroboscopic;
 mod system;
 
 pub use dopri5::Dopri5;
+/// The Dormand-Prince 5(4) tableau: stage times, stage matrix (last row: the solution), error weights.
+pub use dopri5::{A as DOPRI5_A, C as DOPRI5_C, E as DOPRI5_E};
 pub use euler::Euler;
 pub use philox::StepDraws;
 pub use rk4::Rk4;

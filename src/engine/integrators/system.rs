@@ -145,6 +145,23 @@ pub trait Stepper: Send + Sync {
     /// step up, state unchanged, with a failure; the caller, seeing the interrupt set, reports
     /// the interrupt. Steppers of one short step ignore it (their caller asks between steps).
     fn set_interrupt(&mut self, _interrupt: Option<Interrupt>) {}
+
+    /// An adaptive method's next step from (t, y), its starting step computed if it has none
+    /// (which may evaluate the right-hand side); `None` for a method of fixed steps. Another
+    /// backend (the GPU) takes the steps from there.
+    fn next_step(
+        &mut self,
+        _sys: &mut dyn OdeSystem,
+        _t: f64,
+        _y: &[f64],
+        _stats: &mut Stats,
+    ) -> Option<f64> {
+        None
+    }
+
+    /// Go on with `h` as the next step, after another backend took the steps before (the state
+    /// changed outside: nothing cached about it is kept).
+    fn continue_with_step(&mut self, _h: f64) {}
 }
 
 /// Size every scratch buffer of a stepper to the state's length (allocates only when it grows).
