@@ -320,6 +320,35 @@ fn dopri5_rows_agree_across_segments() {
     }
 }
 
+// An interrupt between submissions stops an adaptive device run at an accepted state, which a
+// later run continues from (on the device, from the step size the device left).
+#[test]
+fn an_interrupt_stops_dopri5_on_the_device() {
+    if !gpu_present("an_interrupt_stops_dopri5_on_the_device") {
+        return;
+    }
+    use std::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::Arc;
+    let mut s = mirror_inwards(10.0, true);
+    s.set_integrator(Some(IntegratorSpec::dopri5(1e-6).unwrap()));
+    s.set_backend(Backend::Gpu);
+    let mut g = Simulation::new(s);
+    let calls = Arc::new(AtomicU64::new(0));
+    let c = calls.clone();
+    g.set_interrupt(Some(Arc::new(move || {
+        c.fetch_add(1, Ordering::Relaxed) >= 3
+    })));
+    let t = g.period().unwrap();
+    let err = g.run(100.0 * t).unwrap_err();
+    assert!(matches!(err, EngineError::Interrupted { .. }), "{err}");
+    let stopped = g.time();
+    assert!(stopped > 0.0 && stopped < 100.0 * t, "{}", stopped / t);
+    assert!(g.stats().steps > 0);
+    g.set_interrupt(None);
+    g.run(0.1 * t).unwrap();
+    assert!(g.time() > stopped);
+}
+
 #[test]
 fn recorders_see_the_same_rows() {
     if !gpu_present("recorders_see_the_same_rows") {
