@@ -142,13 +142,28 @@ impl OdeSystem for MicroSystem {
 
     /// The fast variable of a dumbbell is its length |b| (the spring relaxes at
     /// [`Dumbbell::relaxation_rate`]); its centre R_H and direction b̂ are slow.
-    fn settle_like(&self, settled: &[f64], y: &mut [f64]) {
+    fn fast_variables(&self, y: &[f64], out: &mut Vec<f64>) {
+        for s in 0..self.swimmers.len() {
+            out.push(vec3(y, STATE_PER_SWIMMER * s + 3).norm());
+        }
+    }
+
+    /// d|b|/dt = b̂ · db/dt.
+    fn fast_rates(&self, y: &[f64], dy: &[f64], out: &mut Vec<f64>) {
         for s in 0..self.swimmers.len() {
             let i = STATE_PER_SWIMMER * s + 3;
             let b = vec3(y, i);
-            let (len, settled_len) = (b.norm(), vec3(settled, i).norm());
-            if len > 0.0 && len.is_finite() {
-                set_vec3(y, i, &(b * (settled_len / len)));
+            out.push(b.dot(&vec3(dy, i)) / b.norm());
+        }
+    }
+
+    fn set_fast_variables(&self, y: &mut [f64], fast: &[f64]) {
+        for (s, &len) in fast.iter().enumerate() {
+            let i = STATE_PER_SWIMMER * s + 3;
+            let b = vec3(y, i);
+            let now = b.norm();
+            if now > 0.0 && now.is_finite() && len > 0.0 {
+                set_vec3(y, i, &(b * (len / now)));
             }
         }
     }
@@ -291,17 +306,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn settling_keeps_centre_and_direction_and_takes_the_settled_length() {
+    fn the_fast_variables_are_the_lengths() {
         let swimmers = vec![Dumbbell::default(); 2];
         let base = vec![Vector3::zeros(); 2];
         let sys = MicroSystem::new(&swimmers, &base, 1e-3, Mobility::Rpy, Contacts::default());
-        // Swimmer 0 stretched and turned, swimmer 1 compressed.
-        let settled = [1.0, 2.0, 3.0, 5.0, 0.0, 0.0, 4.0, 5.0, 6.0, 0.0, 8.0, 0.0];
         let mut y = [1.5, 2.5, 3.5, 6.0, 8.0, 0.0, 4.0, 5.0, 6.0, 0.0, 0.0, 2.0];
-        sys.settle_like(&settled, &mut y);
-        assert_eq!(&y[0..3], &[1.5, 2.5, 3.5]);
-        assert_eq!(&y[3..6], &[3.0, 4.0, 0.0]);
-        assert_eq!(&y[6..9], &[4.0, 5.0, 6.0]);
-        assert_eq!(&y[9..12], &[0.0, 0.0, 8.0]);
+        let mut fast = Vec::new();
+        sys.fast_variables(&y, &mut fast);
+        assert_eq!(fast, [10.0, 2.0]);
+        // A turn of b has no length rate; a stretch along b has.
+        let dy = [9.0, 9.0, 9.0, -8.0, 6.0, 0.0, 9.0, 9.0, 9.0, 0.0, 0.0, 3.0];
+        let mut rates = Vec::new();
+        sys.fast_rates(&y, &dy, &mut rates);
+        assert_eq!(rates, [0.0, 3.0]);
+        // Setting the lengths keeps centres and directions.
+        sys.set_fast_variables(&mut y, &[5.0, 8.0]);
+        assert_eq!(
+            y,
+            [1.5, 2.5, 3.5, 3.0, 4.0, 0.0, 4.0, 5.0, 6.0, 0.0, 0.0, 8.0]
+        );
     }
 }

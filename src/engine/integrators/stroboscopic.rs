@@ -7,12 +7,15 @@
 //!
 //! - **Slope.** The slope F(y) of the averaged flow at y is read off three consecutive
 //!   stroboscopic points y, Ψ(y), Ψ²(y): the derivative at s = 0 of the quadratic through them
-//!   at s = 0, 1, 2 periods (second order in T). A stage state, extrapolated from states on the
-//!   slow manifold, is put back next to it first ([`OdeSystem::settle_like`]: each spring gets
-//!   the length it has in the step's start state, of the same phase), so the fast motion (a
-//!   spring settling at its relaxation rate) has next to nothing to relax and the macro flow is
-//!   not stiff. Without settling, an extrapolated turn stretches a dumbbell by ~ℓθ²/2; the slope
-//!   then carries that stretch relaxing within a period, and the next stage fails the guards.
+//!   at s = 0, 1, 2 periods (second order in T). A stage state y + H Σ a_j k_j is extrapolated
+//!   from the step's start; its fast variables (the springs' lengths,
+//!   [`OdeSystem::fast_variables`]) are extrapolated instead by their rates on the slow
+//!   manifold, (fast(Ψ²) − fast(Ψ))/T at each earlier stage, which nothing left to relax
+//!   pollutes. So a stage state lies next to the manifold, the fast motion has next to nothing
+//!   to relax, and the macro flow is not stiff. Extrapolated with the slope itself, a spring's
+//!   length would carry its own relaxation (a stiff mode under steps of many periods); left
+//!   alone, an extrapolated turn stretches a dumbbell by ~ℓθ²/2 and the next stage fails the
+//!   guards; set to the start state's length, a close pair errs 60× more (tests/stroboscopic.rs).
 //! - **Macro steps.** Dormand-Prince 5(4) (first-same-as-last: six new slopes a step) in whole
 //!   periods, H = mT, so every macro state is a stroboscopic state of the same phase; every
 //!   stage's Ψ starts at the step's own time. Fifth order rather than Bogacki-Shampine's third:
@@ -46,6 +49,9 @@ const ESTIMATE_ORDER: f64 = 4.0;
 /// drift of ~1e-6 ℓ per period, limits the useful `tol` to ~1e-9.
 const NOISE_PER_PERIOD: f64 = 1e-15;
 
+/// A slope of the averaged flow and the rates of the fast variables on the slow manifold.
+type Slope = (Vec<f64>, Vec<f64>);
+
 /// The stroboscopic averaging stepper (see the module docs).
 pub struct Stroboscopic {
     tol: f64,
@@ -62,7 +68,7 @@ pub struct Stroboscopic {
     /// The (time, state) this stepper left: anything else is a start.
     left: Option<(f64, Vec<f64>)>,
     /// The slope at the state left (first same as last).
-    slope: Option<Vec<f64>>,
+    slope: Option<Slope>,
     /// Macro steps of exactly this many periods, every step accepted (convergence studies).
     fixed: Option<u64>,
     /// Asked between inner steps: a macro step spans many periods.
@@ -155,25 +161,34 @@ impl Stroboscopic {
     }
 
     /// The slope of the averaged flow at `y` (phase of `t`), from y, Ψ(y), Ψ²(y): the derivative
-    /// at 0 of the quadratic through them, (−3y + 4Ψ(y) − Ψ²(y)) / 2T.
+    /// at 0 of the quadratic through them, (−3y + 4Ψ(y) − Ψ²(y)) / 2T; and the rates of the fast
+    /// variables on the slow manifold, (fast(Ψ²(y)) − fast(Ψ(y))) / T, free of whatever y's own
+    /// fast variables had to relax.
     fn slope_at(
         &mut self,
         sys: &mut dyn OdeSystem,
         t: f64,
         y: &[f64],
         stats: &mut Stats,
-    ) -> Result<Vec<f64>, StepFailure> {
+    ) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
         let w = [-1.5 / self.period, 2.0 / self.period, -0.5 / self.period];
         let mut z = y.to_vec();
         let mut f: Vec<f64> = z.iter().map(|v| w[0] * v).collect();
+        let mut fast = [Vec::new(), Vec::new()];
         // Ψ depends on the phase only: each period starts at the phase of t.
-        for wk in &w[1..] {
+        for (wk, fk) in w[1..].iter().zip(&mut fast) {
             self.psi(sys, t, &mut z, 1, stats)?;
             for (fi, zi) in f.iter_mut().zip(&z) {
                 *fi += wk * zi;
             }
+            sys.fast_variables(&z, fk);
         }
-        Ok(f)
+        let rates = fast[1]
+            .iter()
+            .zip(&fast[0])
+            .map(|(b, a)| (b - a) / self.period)
+            .collect();
+        Ok((f, rates))
     }
 
     /// Max over 3-vectors of |err| / (tol · largest change of that kind + round-off allowance).
@@ -208,10 +223,10 @@ impl Stroboscopic {
         sys: &mut dyn OdeSystem,
         t: f64,
         y: &[f64],
-        k1: &[f64],
+        k1: &Slope,
         m: u64,
         stats: &mut Stats,
-    ) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    ) -> Option<(Vec<f64>, Slope, f64)> {
         let h = m as f64 * self.period;
         let n = y.len();
         // y + h Σ a_j k_j over the slopes so far.
@@ -220,23 +235,39 @@ impl Stroboscopic {
                 .map(|i| y[i] + h * a.iter().zip(ks).map(|(aj, k)| aj * k[i]).sum::<f64>())
                 .collect()
         };
-        let mut ks: Vec<Vec<f64>> = vec![k1.to_vec()];
+        // The fast variables (springs' lengths) of the stage states, extrapolated by their rates
+        // on the slow manifold.
+        let mut fast0 = Vec::new();
+        sys.fast_variables(y, &mut fast0);
+        let settle = |z: &mut Vec<f64>, a: &[f64], rates: &[Vec<f64>], sys: &dyn OdeSystem| {
+            if fast0.is_empty() {
+                return;
+            }
+            let fast: Vec<f64> = (0..fast0.len())
+                .map(|q| fast0[q] + h * a.iter().zip(rates).map(|(aj, r)| aj * r[q]).sum::<f64>())
+                .collect();
+            sys.set_fast_variables(z, &fast);
+        };
+        let mut ks: Vec<Vec<f64>> = vec![k1.0.to_vec()];
+        let mut fast_rates: Vec<Vec<f64>> = vec![k1.1.to_vec()];
         for row in 1..6 {
             let mut z = stage(&A[row][..row], &ks);
-            sys.settle_like(y, &mut z);
-            ks.push(self.slope_at(sys, t, &z, stats).ok()?);
+            settle(&mut z, &A[row][..row], &fast_rates, &*sys);
+            let (k, r) = self.slope_at(sys, t, &z, stats).ok()?;
+            ks.push(k);
+            fast_rates.push(r);
         }
         // The last row is the solution (first same as last): its slope starts the next step.
         let mut y_new = stage(&A[6][..6], &ks);
         sys.project(&mut y_new);
-        sys.settle_like(y, &mut y_new);
+        settle(&mut y_new, &A[6][..6], &fast_rates, &*sys);
         check_state(sys, t + h, &y_new).ok()?;
         let k_new = self.slope_at(sys, t, &y_new, stats).ok()?;
         let err: Vec<f64> = (0..n)
             .map(|i| {
                 h * E
                     .iter()
-                    .zip(ks.iter().chain([&k_new]))
+                    .zip(ks.iter().chain([&k_new.0]))
                     .map(|(ej, k)| ej * k[i])
                     .sum::<f64>()
             })

@@ -19,12 +19,16 @@ pub trait OdeSystem {
     }
     /// Map a state back onto its manifold after a step (e.g. renormalise unit vectors).
     fn project(&self, _y: &mut [f64]) {}
-    /// Give the fast variables of `y` the values they have in `settled`, a state of the same
-    /// phase on the slow manifold (a spring's length, settled onto its stroke), keeping the slow
-    /// ones (positions, orientations). Stroboscopic averaging extrapolates slow motion; this
-    /// puts an extrapolated state back next to the manifold, so no period need relax it. A system
-    /// without fast variables (the default) has nothing to settle.
-    fn settle_like(&self, _settled: &[f64], _y: &mut [f64]) {}
+    /// The fast variables of state `y` (a spring's length, one per swimmer), appended to `out`;
+    /// none by default. Stroboscopic averaging extrapolates slow motion: it extrapolates these by
+    /// their rates ([`OdeSystem::fast_rates`]) and sets them ([`OdeSystem::set_fast_variables`])
+    /// in an extrapolated state, keeping it next to the slow manifold (a turn extrapolated
+    /// linearly would stretch a dumbbell), so no period need relax it.
+    fn fast_variables(&self, _y: &[f64], _out: &mut Vec<f64>) {}
+    /// The rates of the fast variables at state `y` for the state's rates `dy`, appended to `out`.
+    fn fast_rates(&self, _y: &[f64], _dy: &[f64], _out: &mut Vec<f64>) {}
+    /// Give `y` the fast variables `fast`, keeping its slow ones (centres, directions).
+    fn set_fast_variables(&self, _y: &mut [f64], _fast: &[f64]) {}
     /// Size of the diagonal blocks of the approximate Jacobian [`OdeSystem::jacobian_blocks`]
     /// offers (0: none; linearly implicit methods then treat the system as non-stiff).
     fn jacobian_block(&self) -> usize {
