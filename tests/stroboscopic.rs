@@ -295,9 +295,9 @@ fn a_close_pair_keeps_the_tolerance() {
         s.run_periods(300.0).unwrap();
     }
     let (mut e, mut n) = (0.0, 0.0);
-    for i in 0..2 {
-        let d = direct.scene().center(i).unwrap() - start[i];
-        let m = strobo.scene().center(i).unwrap() - start[i];
+    for (i, c0) in start.iter().enumerate() {
+        let d = direct.scene().center(i).unwrap() - c0;
+        let m = strobo.scene().center(i).unwrap() - c0;
         e += (m - d).norm_squared();
         n += d.norm_squared();
     }

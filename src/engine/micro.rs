@@ -148,15 +148,6 @@ impl OdeSystem for MicroSystem {
         }
     }
 
-    /// d|b|/dt = b̂ · db/dt.
-    fn fast_rates(&self, y: &[f64], dy: &[f64], out: &mut Vec<f64>) {
-        for s in 0..self.swimmers.len() {
-            let i = STATE_PER_SWIMMER * s + 3;
-            let b = vec3(y, i);
-            out.push(b.dot(&vec3(dy, i)) / b.norm());
-        }
-    }
-
     fn set_fast_variables(&self, y: &mut [f64], fast: &[f64]) {
         for (s, &len) in fast.iter().enumerate() {
             let i = STATE_PER_SWIMMER * s + 3;
@@ -314,11 +305,6 @@ mod tests {
         let mut fast = Vec::new();
         sys.fast_variables(&y, &mut fast);
         assert_eq!(fast, [10.0, 2.0]);
-        // A turn of b has no length rate; a stretch along b has.
-        let dy = [9.0, 9.0, 9.0, -8.0, 6.0, 0.0, 9.0, 9.0, 9.0, 0.0, 0.0, 3.0];
-        let mut rates = Vec::new();
-        sys.fast_rates(&y, &dy, &mut rates);
-        assert_eq!(rates, [0.0, 3.0]);
         // Setting the lengths keeps centres and directions.
         sys.set_fast_variables(&mut y, &[5.0, 8.0]);
         assert_eq!(

@@ -21,12 +21,10 @@ pub trait OdeSystem {
     fn project(&self, _y: &mut [f64]) {}
     /// The fast variables of state `y` (a spring's length, one per swimmer), appended to `out`;
     /// none by default. Stroboscopic averaging extrapolates slow motion: it extrapolates these by
-    /// their rates ([`OdeSystem::fast_rates`]) and sets them ([`OdeSystem::set_fast_variables`])
-    /// in an extrapolated state, keeping it next to the slow manifold (a turn extrapolated
-    /// linearly would stretch a dumbbell), so no period need relax it.
+    /// their rates on the slow manifold and sets them ([`OdeSystem::set_fast_variables`]) in an
+    /// extrapolated state, keeping it next to the manifold (a turn extrapolated linearly would
+    /// stretch a dumbbell), so no period need relax it.
     fn fast_variables(&self, _y: &[f64], _out: &mut Vec<f64>) {}
-    /// The rates of the fast variables at state `y` for the state's rates `dy`, appended to `out`.
-    fn fast_rates(&self, _y: &[f64], _dy: &[f64], _out: &mut Vec<f64>) {}
     /// Give `y` the fast variables `fast`, keeping its slow ones (centres, directions).
     fn set_fast_variables(&self, _y: &mut [f64], _fast: &[f64]) {}
     /// Size of the diagonal blocks of the approximate Jacobian [`OdeSystem::jacobian_blocks`]
