@@ -94,6 +94,23 @@ impl Workspace {
     pub fn forget_stepper(&mut self) {
         self.stepper = None;
     }
+
+    /// The cached stepper, reset, if it was built for `spec` and the scene key `key`; else a new
+    /// one for the scene.
+    fn take_stepper(
+        &mut self,
+        s: &Scene,
+        spec: IntegratorSpec,
+        key: &[u64],
+    ) -> Result<Box<dyn Stepper>> {
+        match self.stepper.take() {
+            Some((cached, cached_key, mut st)) if cached == spec && cached_key == key => {
+                st.reset();
+                Ok(st)
+            }
+            _ => s.stepper(spec),
+        }
+    }
 }
 
 /// Step `s` to `t_end` on the CPU with the guards, taking at most `max_steps` steps.
@@ -107,13 +124,7 @@ pub fn advance_cpu(
     let mut sys = s.system()?;
     let spec = s.integrator();
     let key = s.stepper_key(spec);
-    let mut stepper = match ws.stepper.take() {
-        Some((cached, cached_key, mut st)) if cached == spec && cached_key == key => {
-            st.reset();
-            st
-        }
-        _ => s.stepper(spec)?,
-    };
+    let mut stepper = ws.take_stepper(s, spec, &key)?;
     stepper.set_interrupt(control.interrupt.clone());
     let mut outcome = Ok(());
     let mut taken = 0;
@@ -263,13 +274,7 @@ fn adaptive_on_gpu(
     let spec = s.integrator();
     let key = s.stepper_key(spec);
     let mut sys = s.system()?;
-    let mut stepper = match ws.stepper.take() {
-        Some((cached, cached_key, mut st)) if cached == spec && cached_key == key => {
-            st.reset();
-            st
-        }
-        _ => s.stepper(spec)?,
-    };
+    let mut stepper = ws.take_stepper(s, spec, &key)?;
     let mut scale = vec![0.0; s.state.len()];
     sys.error_scale(&s.state, &mut scale);
     let stages = run.stages() as u64 - 1;

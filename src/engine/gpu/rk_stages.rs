@@ -110,10 +110,9 @@ impl Tableau {
     /// Adaptive: stages 1..S (the last, at the solution, checked by the guards), then the error
     /// weights, then stage 0 at y.
     pub(crate) fn stage_params(&self) -> Vec<StageParams> {
-        if self.is_adaptive() {
-            return self.adaptive_stage_params();
-        }
         let s = self.stages();
+        let adaptive = self.is_adaptive();
+        // Stages 1..S; adaptive: the last one is taken at the solution and checked by the guards.
         let mut out: Vec<StageParams> = (1..s)
             .map(|i| StageParams {
                 a: Self::coefficients(&self.a[i]),
@@ -121,62 +120,37 @@ impl Tableau {
                 src: 0,
                 out: i as u32,
                 nk: i as u32,
-                check: 0,
+                check: u32::from(adaptive && i == s - 1),
             })
             .collect();
+        // The weights b of the combination, or the error weights e.
         out.push(StageParams {
-            a: Self::coefficients(&self.b),
+            a: Self::coefficients(if adaptive { &self.e } else { &self.b }),
             c: 1.0,
             src: 0,
             out: 0,
             nk: s as u32,
             check: 0,
         });
+        if !adaptive {
+            out.push(StageParams {
+                a: [0.0; 8],
+                c: 1.0,
+                src: 1,
+                out: 0,
+                nk: 0,
+                check: 1,
+            });
+        }
+        // Stage 0 at y: the rates that start a run.
         out.push(StageParams {
-            a: [0.0; 8],
-            c: 1.0,
-            src: 1,
-            out: 0,
-            nk: 0,
-            check: 1,
-        });
-        out.push(Self::start());
-        out
-    }
-
-    /// Stage 0 at y: the rates that start a run.
-    fn start() -> StageParams {
-        StageParams {
             a: [0.0; 8],
             c: 0.0,
             src: 0,
             out: 0,
             nk: 0,
             check: 0,
-        }
-    }
-
-    fn adaptive_stage_params(&self) -> Vec<StageParams> {
-        let s = self.stages();
-        let mut out: Vec<StageParams> = (1..s)
-            .map(|i| StageParams {
-                a: Self::coefficients(&self.a[i]),
-                c: self.c[i],
-                src: 0,
-                out: i as u32,
-                nk: i as u32,
-                check: u32::from(i == s - 1),
-            })
-            .collect();
-        out.push(StageParams {
-            a: Self::coefficients(&self.e),
-            c: 1.0,
-            src: 0,
-            out: 0,
-            nk: s as u32,
-            check: 0,
         });
-        out.push(Self::start());
         out
     }
 }

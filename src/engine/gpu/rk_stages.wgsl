@@ -2,6 +2,26 @@
 // the adaptive Dormand-Prince 5(4) step: error norm, accept/reject and step size decided on the
 // device, as the CPU's Dopri5 decides them (integrators/dopri5.rs).
 
+// Σ_{j<nk} a_j k_j of state component i, with the stage's coefficients a.
+fn combination(i: u32) -> f64 {
+    var acc = 0.0lf;
+    for (var j = 0u; j < stage.nk; j++) {
+        acc += stage.a[j] * k[j * params.nstate + i];
+    }
+    return acc;
+}
+
+// A swimmer's state with its N (components 3-5, averaged model) made a unit vector again.
+fn renormalised(v: array<f64, 6>) -> array<f64, 6> {
+    var out = v;
+    let nv = vec3<f64>(v[3], v[4], v[5]);
+    let u = nv / sqrt(dot(nv, nv));
+    out[3] = u.x;
+    out[4] = u.y;
+    out[5] = u.z;
+    return out;
+}
+
 // y_stage = src + h Σ_{j<nk} a_j k_j.
 @compute @workgroup_size(64)
 fn stage_state(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -11,10 +31,7 @@ fn stage_state(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     for (var c = 0u; c < 6u; c++) {
         let i = 6u * s + c;
-        var acc = 0.0lf;
-        for (var j = 0u; j < stage.nk; j++) {
-            acc += stage.a[j] * k[j * params.nstate + i];
-        }
+        let acc = combination(i);
         var base = y[i];
         if stage.src == 1u {
             base = y_new[i];
@@ -34,18 +51,11 @@ fn combine(@builtin(global_invocation_id) gid: vec3<u32>) {
     var v: array<f64, 6>;
     for (var c = 0u; c < 6u; c++) {
         let i = 6u * s + c;
-        var acc = 0.0lf;
-        for (var j = 0u; j < stage.nk; j++) {
-            acc += stage.a[j] * k[j * params.nstate + i];
-        }
+        let acc = combination(i);
         v[c] = y[i] + step_size() * acc;
     }
     if params.project == 1u {
-        let nv = vec3<f64>(v[3], v[4], v[5]);
-        let u = nv / sqrt(dot(nv, nv));
-        v[3] = u.x;
-        v[4] = u.y;
-        v[5] = u.z;
+        v = renormalised(v);
     }
     for (var c = 0u; c < 6u; c++) {
         // False for NaN as well as ±inf.
@@ -112,20 +122,13 @@ fn error_part(@builtin(global_invocation_id) gid: vec3<u32>) {
     var v: array<f64, 6>;
     for (var c = 0u; c < 6u; c++) {
         let i = 6u * s + c;
-        var acc = 0.0lf;
-        for (var j = 0u; j < stage.nk; j++) {
-            acc += stage.a[j] * k[j * params.nstate + i];
-        }
+        let acc = combination(i);
         let r = control.h_try * acc / (params.rtol * adapt[i]);
         sum += r * r;
         v[c] = y_stage[i];
     }
     if params.project == 1u {
-        let nv = vec3<f64>(v[3], v[4], v[5]);
-        let u = nv / sqrt(dot(nv, nv));
-        v[3] = u.x;
-        v[4] = u.y;
-        v[5] = u.z;
+        v = renormalised(v);
     }
     for (var c = 0u; c < 6u; c++) {
         y_new[6u * s + c] = v[c];

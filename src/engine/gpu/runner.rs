@@ -486,33 +486,16 @@ impl GpuRun {
     /// Encode and submit `m` adaptive attempts (and, on a run's first submission, the rates at
     /// the start); attempts after the run's end or a failure return at once.
     fn submit_attempts(&self, m: u64, first: bool) {
-        let groups = (self.n as u32).div_ceil(WORKGROUP);
         let s = self.tableau.stages();
         // Bind groups in the order of Tableau::stage_params: rows 1..S, error weights, start.
         let (error, start) = (s - 1, s);
-        let mut enc = self
-            .dev
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("attempts"),
-            });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("attempts"),
-                timestamp_writes: None,
-            });
-            pass.set_bind_group(0, &self.group0, &[]);
+        self.submit("attempts", first, start, |pass, groups| {
             let k = &self.kernels;
-            // Every pipeline's layout has group 1; begin_attempt reads no stage.
-            pass.set_bind_group(1, &self.stages[start], &[]);
-            if first {
-                self.encode_rates(&mut pass, start, groups);
-            }
             for _ in 0..m {
                 pass.set_pipeline(&k.stages.begin_attempt);
                 pass.dispatch_workgroups(1, 1, 1);
                 for stage in 0..s - 1 {
-                    self.encode_rates(&mut pass, stage, groups);
+                    self.encode_rates(pass, stage, groups);
                 }
                 pass.set_bind_group(1, &self.stages[error], &[]);
                 pass.set_pipeline(&k.stages.error_part);
@@ -522,6 +505,35 @@ impl GpuRun {
                 pass.set_pipeline(&k.stages.commit_attempt);
                 pass.dispatch_workgroups(groups, 1, 1);
             }
+        });
+    }
+
+    /// One submission: a compute pass with group 0 and the bind group `start` (stage 0) set, the
+    /// rates at the start if `first`, then `body`; then the control block copied for read-back.
+    fn submit(
+        &self,
+        label: &str,
+        first: bool,
+        start: usize,
+        body: impl FnOnce(&mut wgpu::ComputePass<'_>, u32),
+    ) {
+        let groups = (self.n as u32).div_ceil(WORKGROUP);
+        let mut enc = self
+            .dev
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(label),
+                timestamp_writes: None,
+            });
+            pass.set_bind_group(0, &self.group0, &[]);
+            // Every pipeline's layout has group 1, also those that read no stage.
+            pass.set_bind_group(1, &self.stages[start], &[]);
+            if first {
+                self.encode_rates(&mut pass, start, groups);
+            }
+            body(&mut pass, groups);
         }
         enc.copy_buffer_to_buffer(
             &self.control,
@@ -555,47 +567,24 @@ impl GpuRun {
 
     /// Encode and submit `m` steps (and, on a run's first submission, the rates at the start).
     fn submit_steps(&self, m: u64, first: bool) {
-        let groups = (self.n as u32).div_ceil(WORKGROUP);
         let s = self.tableau.stages();
         // Bind groups in the order of Tableau::stage_params.
         let (combine, check, start) = (s - 1, s, s + 1);
-        let mut enc = self
-            .dev
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("steps"),
-            });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("steps"),
-                timestamp_writes: None,
-            });
-            pass.set_bind_group(0, &self.group0, &[]);
+        self.submit("steps", first, start, |pass, groups| {
             let k = &self.kernels;
-            if first {
-                self.encode_rates(&mut pass, start, groups);
-            }
             for _ in 0..m {
                 for stage in 0..s - 1 {
-                    self.encode_rates(&mut pass, stage, groups);
+                    self.encode_rates(pass, stage, groups);
                 }
                 pass.set_bind_group(1, &self.stages[combine], &[]);
                 pass.set_pipeline(&k.stages.combine);
                 pass.dispatch_workgroups(groups, 1, 1);
                 // The rates at y_new: the guards' contact test, and k_0 of the next step.
-                self.encode_rates(&mut pass, check, groups);
+                self.encode_rates(pass, check, groups);
                 pass.set_pipeline(&k.stages.commit);
                 pass.dispatch_workgroups(groups, 1, 1);
             }
-        }
-        enc.copy_buffer_to_buffer(
-            &self.control,
-            0,
-            &self.read_control,
-            0,
-            std::mem::size_of::<Control>() as u64,
-        );
-        self.dev.queue.submit([enc.finish()]);
+        });
     }
 
     fn read_control(&self) -> Result<Control, String> {

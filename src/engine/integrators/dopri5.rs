@@ -96,6 +96,33 @@ impl Dopri5 {
             .sqrt()
     }
 
+    /// Buffers sized to y, the error scale at y, and the rates at (t, y) in the first stage slot
+    /// unless they are there already (first same as last).
+    fn prepare(&mut self, sys: &mut dyn OdeSystem, t: f64, y: &[f64], stats: &mut Stats) {
+        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
+        fit(
+            y.len(),
+            &mut [
+                k1,
+                k2,
+                k3,
+                k4,
+                k5,
+                k6,
+                k7,
+                &mut self.tmp,
+                &mut self.y_new,
+                &mut self.scale,
+            ],
+        );
+        sys.error_scale(y, &mut self.scale);
+        if !self.fsal_valid {
+            sys.rhs(t, y, &mut self.k[0]);
+            stats.rhs_evals += 1;
+            self.fsal_valid = true;
+        }
+    }
+
     /// The Dormand-Prince 5th-order formula with fixed steps of at most `dt` and no error control.
     pub fn fixed_step(dt: f64) -> Self {
         Dopri5 {
@@ -159,28 +186,7 @@ impl Stepper for Dopri5 {
         stats: &mut Stats,
     ) -> Result<f64, StepFailure> {
         let n = y.len();
-        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
-        fit(
-            n,
-            &mut [
-                k1,
-                k2,
-                k3,
-                k4,
-                k5,
-                k6,
-                k7,
-                &mut self.tmp,
-                &mut self.y_new,
-                &mut self.scale,
-            ],
-        );
-        sys.error_scale(y, &mut self.scale);
-        if !self.fsal_valid {
-            sys.rhs(t, y, &mut self.k[0]);
-            stats.rhs_evals += 1;
-            self.fsal_valid = true;
-        }
+        self.prepare(sys, t, y, stats);
         let mut h = match (self.fixed, self.h) {
             (Some(dt), _) => super::system::uniform_step(t, t_end, dt).0,
             (None, Some(h)) => h,
@@ -278,15 +284,8 @@ impl Stepper for Dopri5 {
             return None;
         }
         if self.h.is_none() {
-            let n = y.len();
-            let [k1, k2, ..] = &mut self.k;
-            fit(n, &mut [k1, k2, &mut self.tmp, &mut self.scale]);
-            sys.error_scale(y, &mut self.scale);
-            sys.rhs(t, y, &mut self.k[0]);
-            stats.rhs_evals += 1;
+            self.prepare(sys, t, y, stats);
             self.h = Some(self.initial_step(sys, t, y, stats));
-            // The second stage slot was overwritten: the rates at y are recomputed by whoever steps.
-            self.fsal_valid = false;
         }
         self.h
     }

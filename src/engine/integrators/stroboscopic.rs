@@ -52,6 +52,13 @@ const NOISE_PER_PERIOD: f64 = 1e-15;
 /// A slope of the averaged flow and the rates of the fast variables on the slow manifold.
 type Slope = (Vec<f64>, Vec<f64>);
 
+/// base + h Σ_j a_j v_j, component by component.
+fn extrapolate(base: &[f64], h: f64, a: &[f64], vs: &[Vec<f64>]) -> Vec<f64> {
+    (0..base.len())
+        .map(|i| base[i] + h * a.iter().zip(vs).map(|(aj, v)| aj * v[i]).sum::<f64>())
+        .collect()
+}
+
 /// The stroboscopic averaging stepper (see the module docs).
 pub struct Stroboscopic {
     tol: f64,
@@ -229,38 +236,24 @@ impl Stroboscopic {
     ) -> Option<(Vec<f64>, Slope, f64)> {
         let h = m as f64 * self.period;
         let n = y.len();
-        // y + h Σ a_j k_j over the slopes so far.
-        let stage = |a: &[f64], ks: &[Vec<f64>]| -> Vec<f64> {
-            (0..n)
-                .map(|i| y[i] + h * a.iter().zip(ks).map(|(aj, k)| aj * k[i]).sum::<f64>())
-                .collect()
-        };
-        // The fast variables (springs' lengths) of the stage states, extrapolated by their rates
-        // on the slow manifold.
+        // The fast variables (springs' lengths) of the stage states are extrapolated by their
+        // rates on the slow manifold, the rest of the state by the slopes.
         let mut fast0 = Vec::new();
         sys.fast_variables(y, &mut fast0);
-        let settle = |z: &mut Vec<f64>, a: &[f64], rates: &[Vec<f64>], sys: &dyn OdeSystem| {
-            if fast0.is_empty() {
-                return;
-            }
-            let fast: Vec<f64> = (0..fast0.len())
-                .map(|q| fast0[q] + h * a.iter().zip(rates).map(|(aj, r)| aj * r[q]).sum::<f64>())
-                .collect();
-            sys.set_fast_variables(z, &fast);
-        };
         let mut ks: Vec<Vec<f64>> = vec![k1.0.to_vec()];
         let mut fast_rates: Vec<Vec<f64>> = vec![k1.1.to_vec()];
         for row in 1..6 {
-            let mut z = stage(&A[row][..row], &ks);
-            settle(&mut z, &A[row][..row], &fast_rates, &*sys);
+            let a = &A[row][..row];
+            let mut z = extrapolate(y, h, a, &ks);
+            sys.set_fast_variables(&mut z, &extrapolate(&fast0, h, a, &fast_rates));
             let (k, r) = self.slope_at(sys, t, &z, stats).ok()?;
             ks.push(k);
             fast_rates.push(r);
         }
         // The last row is the solution (first same as last): its slope starts the next step.
-        let mut y_new = stage(&A[6][..6], &ks);
+        let mut y_new = extrapolate(y, h, &A[6][..6], &ks);
         sys.project(&mut y_new);
-        settle(&mut y_new, &A[6][..6], &fast_rates, &*sys);
+        sys.set_fast_variables(&mut y_new, &extrapolate(&fast0, h, &A[6][..6], &fast_rates));
         check_state(sys, t + h, &y_new).ok()?;
         let k_new = self.slope_at(sys, t, &y_new, stats).ok()?;
         let err: Vec<f64> = (0..n)
