@@ -346,6 +346,14 @@ fn contact_settings_are_checked() {
     assert!(e.contains("range must be a positive number"), "{e}");
     let e = script("let s = scene(); s.steric = #{ range: 1e-7 };").unwrap_err();
     assert!(e.contains("needs both range and stiffness"), "{e}");
+    let e = script("let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3, body: \"rod\" };")
+        .unwrap_err();
+    assert!(e.contains("rods") && e.contains("spheres"), "{e}");
+    script(
+        "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3, body: \"rods\" }; \
+         if s.steric.body != \"rods\" { throw \"body not kept\" }",
+    )
+    .unwrap();
     let e = script("let s = scene(); s.overlaps = \"sometimes\";").unwrap_err();
     assert!(e.contains("stop") && e.contains("allow"), "{e}");
     let e = script("let s = scene(); s.cutoff = 0;").unwrap_err();

@@ -37,7 +37,7 @@ pub mod thermal;
 pub mod trajectory;
 
 pub use backend::Backend;
-pub use contacts::{Contacts, Overlaps, Steric};
+pub use contacts::{Contacts, Overlaps, Steric, StericBody};
 pub use error::{EngineError, Result};
 pub use integrators::IntegratorSpec;
 pub use mobility::Mobility;
