@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{aligned_pair, mirror_inwards, ELL};
+use common::{about_to_touch, aligned_pair, mirror_inwards, ELL};
 use nalgebra::Vector3;
 use swimlab::engine::build::{random_suspension, Orientations, Phases};
 use swimlab::engine::error::Setting;
@@ -226,6 +226,37 @@ fn unstable_step_fails_the_same_way_on_both_backends() {
     assert_eq!(errors[0], errors[1]);
     assert_eq!(c.time(), g.time());
     assert!(errors[1].contains("spring"), "{}", errors[1]);
+}
+
+// dopri5 into a contact on the device: an accepted attempt whose state has two spheres
+// overlapping ends the submission; the CPU replays that step from the step size it began with,
+// its guard refuses it, and the step shrinks towards the contact until it stops advancing the
+// time (the CPU stepper's floor). Both backends then stop with the same error naming the same
+// spheres, at times within 1e-9 of each other (the crawl's last steps depend on rounding, so the
+// step counts may differ by a few), each scene at a state whose spheres do not overlap.
+#[test]
+fn dopri5_into_a_contact_stops_the_same_way_on_both_backends() {
+    if !gpu_present("dopri5_into_a_contact_stops_the_same_way_on_both_backends") {
+        return;
+    }
+    for rtol in [1e-3, 1e-6] {
+        let (mut c, mut g) = sim_twins(&about_to_touch());
+        let mut ends = Vec::new();
+        for x in [&mut c, &mut g] {
+            x.scene_mut()
+                .set_integrator(Some(IntegratorSpec::dopri5(rtol).unwrap()));
+            let e = x.run_periods(1.0).unwrap_err().to_string();
+            let gap = swimlab::engine::Observable::MinGap.evaluate(x).unwrap()[0];
+            eprintln!("dopri5({rtol:e}): t = {:e}, gap {gap:e}, {:?}", x.time(), x.stats());
+            assert!(gap >= 0.0, "gap {gap:e}");
+            let cause = e.split(": ").nth(1).unwrap_or("").split(" (gap").next().unwrap_or("");
+            ends.push((cause.to_string(), x.time()));
+        }
+        assert!(ends[0].0.contains("overlaps"), "{ends:?}");
+        assert_eq!(ends[0].0, ends[1].0);
+        assert!((ends[0].1 - ends[1].1).abs() <= 1e-9 * ends[0].1, "{ends:?}");
+        assert!(g.stats().rejected_by_guard > 0, "{:?}", g.stats());
+    }
 }
 
 /// Both backends run `s` with dopri5(`rtol`) for `duration` seconds: the same steps and

@@ -102,3 +102,16 @@ pub fn python_with(modules: &str, require: &str, install: &str) -> Option<std::p
     }
     found
 }
+
+/// Two Fig-1 swimmers at right angles, swimmer 1's first sphere 0.02 µm above swimmer 0's second
+/// one at t = 0: the strokes (±λ/2 per sphere) push the two spheres into each other within the
+/// first period (contact at t ≈ 0.029 T).
+pub fn about_to_touch() -> Scene {
+    let d = Dumbbell::default();
+    let mut s = Scene::new();
+    s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
+    let y = 2.0 * d.a1 + 0.02e-6 + d.ell / 2.0;
+    s.add(d, Vector3::new(d.ell / 2.0, y, 0.0), Vector3::y())
+        .unwrap();
+    s
+}

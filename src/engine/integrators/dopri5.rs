@@ -1,7 +1,7 @@
 //! Dormand-Prince 5(4) with embedded error estimate, FSAL, and Hairer's PI step-size controller
 //! (Hairer, Nørsett & Wanner, *Solving ODEs I*, II.4 and the `DOPRI5` code).
 
-use super::system::{check_state, fit, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
+use super::system::{check_state, fit, stalled, step_too_small, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
 
 /// Stage times (the GPU backend takes the same tableau).
 pub const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
@@ -63,6 +63,9 @@ pub struct Dopri5 {
     fixed: Option<f64>,
     h: Option<f64>,
     fac_old: f64,
+    /// The contact (or other guard) failure that shrank the last step, if one did: the error
+    /// to stop with should the step then fall below what can advance the time.
+    guarded: Option<StepFailure>,
     fsal_valid: bool,
     k: [Vec<f64>; 7],
     tmp: Vec<f64>,
@@ -78,6 +81,7 @@ impl Dopri5 {
             fixed: None,
             h: None,
             fac_old: 1e-4,
+            guarded: None,
             fsal_valid: false,
             k: Default::default(),
             tmp: Vec::new(),
@@ -194,9 +198,15 @@ impl Stepper for Dopri5 {
         };
         let mut rejected_last = false;
         let mut rejects = 0;
+        let carried = self.guarded.take();
+        let mut guard_failure = None;
         loop {
             let span = t_end - t;
             let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
+            if !last && self.fixed.is_none() && step_too_small(h_try, t) {
+                self.h = Some(h_try);
+                return Err(stalled(t, h_try, guard_failure.or(carried)));
+            }
             for s in 1..7 {
                 for i in 0..n {
                     let mut acc = 0.0;
@@ -238,6 +248,7 @@ impl Stepper for Dopri5 {
                     y.copy_from_slice(&self.y_new);
                     self.k.swap(0, 6);
                     stats.steps += 1;
+                    self.guarded = guard_failure;
                     return Ok(t_new);
                 }
                 (true, Err(failure)) => {
@@ -248,6 +259,7 @@ impl Stepper for Dopri5 {
                         self.h = Some(h_try);
                         return Err(failure);
                     }
+                    guard_failure = Some(failure);
                     h = h_try * 0.25;
                 }
                 (false, _) => {
@@ -271,6 +283,7 @@ impl Stepper for Dopri5 {
     fn reset(&mut self) {
         self.fsal_valid = false;
         self.fac_old = 1e-4;
+        self.guarded = None;
     }
 
     fn next_step(

@@ -11,7 +11,7 @@
 //! Stage equations (Hairer & Wanner, IV.7, with k including the factor h):
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
 
-use super::system::{check_state, fit, tolerance_failure, Problem, StepFailure};
+use super::system::{check_state, fit, stalled, step_too_small, tolerance_failure, Problem, StepFailure};
 use super::{OdeSystem, Stats, Stepper};
 use nalgebra::{DMatrix, DVector};
 
@@ -54,6 +54,9 @@ pub struct Rosenbrock {
     rtol: f64,
     fixed: Option<f64>,
     h: Option<f64>,
+    /// The contact (or other guard) failure that shrank the last step, if one did: the error
+    /// to stop with should the step then fall below what can advance the time.
+    guarded: Option<StepFailure>,
     k: [Vec<f64>; 4],
     f: Vec<f64>,
     f0: Vec<f64>,
@@ -76,6 +79,7 @@ impl Rosenbrock {
             rtol,
             fixed: None,
             h: None,
+            guarded: None,
             k: Default::default(),
             f: Vec::new(),
             f0: Vec::new(),
@@ -229,9 +233,15 @@ impl Stepper for Rosenbrock {
             (None, None) => (t_end - t).min(1e-3 * (t_end - t).max(1e-9)),
         };
         let mut rejects = 0;
+        let carried = self.guarded.take();
+        let mut guard_failure = None;
         loop {
             let span = t_end - t;
             let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
+            if !last && self.fixed.is_none() && step_too_small(h_try, t) {
+                self.h = Some(h_try);
+                return Err(stalled(t, h_try, guard_failure.or(carried)));
+            }
             self.lus = (0..n.checked_div(bs).unwrap_or(0))
                 .map(|blk| {
                     let jb = &self.jac[blk * bs * bs..(blk + 1) * bs * bs];
@@ -262,6 +272,7 @@ impl Stepper for Rosenbrock {
                 (true, Ok(())) => {
                     y.copy_from_slice(&self.y_new);
                     stats.steps += 1;
+                    self.guarded = guard_failure;
                     let h_next = h_try * fac;
                     self.h = Some(if last && h_try < h {
                         h.max(h_next)
@@ -277,6 +288,7 @@ impl Stepper for Rosenbrock {
                     if fixed || rejects >= MAX_REJECTS {
                         return Err(failure);
                     }
+                    guard_failure = Some(failure);
                     h = h_try * 0.25;
                 }
                 (false, _) => {

@@ -224,6 +224,32 @@ pub(crate) fn tolerance_failure(time: f64, h: f64, rejects: u32) -> StepFailure 
     }
 }
 
+/// Whether an adaptive step `h` (s) at time `t` is too small to go on: below
+/// [`MIN_RELATIVE_INTERVAL`] of t, steps no longer advance the time measurably. An adaptive method
+/// that shrinks its step there is crawling towards an event it cannot pass (two spheres about to
+/// touch, where every larger step is refused by the contact guard), and stops with that event's
+/// error instead of spinning forever.
+pub(crate) fn step_too_small(h: f64, t: f64) -> bool {
+    h < MIN_RELATIVE_INTERVAL * t.abs()
+}
+
+/// The error of an adaptive method whose step fell below [`step_too_small`]'s floor: the guard's
+/// failure that forced it there, if one did, else the error estimate's.
+pub(crate) fn stalled(time: f64, h: f64, guard: Option<StepFailure>) -> StepFailure {
+    guard.unwrap_or_else(|| StepFailure {
+        time,
+        problem: Problem {
+            swimmer: None,
+            cause: format!(
+                "the step fell to {h:e} s, below what f64 can advance the time by at t = {time:e} s, to keep the error estimate within tolerance"
+            ),
+            hint: "loosen the tolerance, or check the scene for NaN or nearly touching spheres"
+                .into(),
+            fixes: Vec::new(),
+        },
+    })
+}
+
 /// The finest interval (a step, a recorder's period) relative to the times it is used at: below
 /// this, consecutive steps or due times can no longer be told apart in f64.
 pub const MIN_RELATIVE_INTERVAL: f64 = 1e-12;
