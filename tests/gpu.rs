@@ -247,14 +247,27 @@ fn dopri5_into_a_contact_stops_the_same_way_on_both_backends() {
                 .set_integrator(Some(IntegratorSpec::dopri5(rtol).unwrap()));
             let e = x.run_periods(1.0).unwrap_err().to_string();
             let gap = swimlab::engine::Observable::MinGap.evaluate(x).unwrap()[0];
-            eprintln!("dopri5({rtol:e}): t = {:e}, gap {gap:e}, {:?}", x.time(), x.stats());
+            eprintln!(
+                "dopri5({rtol:e}): t = {:e}, gap {gap:e}, {:?}",
+                x.time(),
+                x.stats()
+            );
             assert!(gap >= 0.0, "gap {gap:e}");
-            let cause = e.split(": ").nth(1).unwrap_or("").split(" (gap").next().unwrap_or("");
+            let cause = e
+                .split(": ")
+                .nth(1)
+                .unwrap_or("")
+                .split(" (gap")
+                .next()
+                .unwrap_or("");
             ends.push((cause.to_string(), x.time()));
         }
         assert!(ends[0].0.contains("overlaps"), "{ends:?}");
         assert_eq!(ends[0].0, ends[1].0);
-        assert!((ends[0].1 - ends[1].1).abs() <= 1e-9 * ends[0].1, "{ends:?}");
+        assert!(
+            (ends[0].1 - ends[1].1).abs() <= 1e-9 * ends[0].1,
+            "{ends:?}"
+        );
         assert!(g.stats().rejected_by_guard > 0, "{:?}", g.stats());
     }
 }

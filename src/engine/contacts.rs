@@ -288,8 +288,8 @@ impl Steric {
             .fold(0.0, f64::max);
         let reach_max = self.range + 2.0 * radii.iter().copied().fold(0.0, f64::max) + longest;
         let fits = periodic.is_none_or(|b| reach_max <= 0.5 * b.shortest());
-        let grid = (pos.len() >= super::pairs::CELL_LIST_SPHERES && fits && reach_max > 0.0)
-            .then(|| {
+        let grid =
+            (pos.len() >= super::pairs::CELL_LIST_SPHERES && fits && reach_max > 0.0).then(|| {
                 let mid = |d: usize| -> Vec<f64> {
                     (0..swimmers)
                         .map(|k| 0.5 * (pos[2 * k][d] + pos[2 * k + 1][d]))
@@ -328,7 +328,10 @@ impl Steric {
                 .enumerate()
                 .for_each(|(i, f)| row(i, f));
         } else {
-            forces.chunks_mut(2).enumerate().for_each(|(i, f)| row(i, f));
+            forces
+                .chunks_mut(2)
+                .enumerate()
+                .for_each(|(i, f)| row(i, f));
         }
     }
 }
@@ -450,7 +453,9 @@ mod tests {
         let radii: Vec<f64> = (0..2 * swimmers)
             .map(|i| if i % 2 == 0 { 1e-6 } else { 0.5e-6 })
             .collect();
-        let st = Steric::new(0.5e-6, 1e-3).unwrap().with_body(StericBody::Rods);
+        let st = Steric::new(0.5e-6, 1e-3)
+            .unwrap()
+            .with_body(StericBody::Rods);
         // Open space, and the same points in a periodic box of the cloud's side (pairs across
         // the faces by their minimum images).
         let in_box = PeriodicBox::new([side; 3]).unwrap();
@@ -498,12 +503,18 @@ mod tests {
         ];
         let spheres = Steric::new(range, k).unwrap();
         let rods = spheres.with_body(StericBody::Rods);
-        assert!(forces(&spheres, &crossed, &radii).iter().all(|f| *f == Vector3::zeros()));
+        assert!(forces(&spheres, &crossed, &radii)
+            .iter()
+            .all(|f| *f == Vector3::zeros()));
         let f = forces(&rods, &crossed, &radii);
         let push = k * (range + 2.0 * a - h);
         for (sphere, sign) in [(0, -1.0), (1, -1.0), (2, 1.0), (3, 1.0)] {
             let want = Vector3::new(0.0, 0.0, sign * 0.5 * push);
-            assert!((f[sphere] - want).norm() < 1e-12 * push, "sphere {sphere}: {:?}", f[sphere]);
+            assert!(
+                (f[sphere] - want).norm() < 1e-12 * push,
+                "sphere {sphere}: {:?}",
+                f[sphere]
+            );
         }
         // End to end along x, unequal radii: the rods' reach there is the spheres' own.
         let radii = [a, 0.6 * a, 0.8 * a, a];
@@ -515,10 +526,16 @@ mod tests {
             Vector3::new(x2, 0.0, 0.0),
             Vector3::new(x2 + ell, 0.0, 0.0),
         ];
-        let (fs, fr) = (forces(&spheres, &line, &radii), forces(&rods, &line, &radii));
+        let (fs, fr) = (
+            forces(&spheres, &line, &radii),
+            forces(&rods, &line, &radii),
+        );
         assert!(fs[1].norm() > 0.0);
         for (x, y) in fs.iter().zip(&fr) {
-            assert!((x - y).norm() <= 1e-12 * fs[1].norm(), "{x:?} against {y:?}");
+            assert!(
+                (x - y).norm() <= 1e-12 * fs[1].norm(),
+                "{x:?} against {y:?}"
+            );
         }
     }
 
@@ -527,14 +544,40 @@ mod tests {
     fn closest_points_of_segments() {
         let v = Vector3::new;
         let close = |got: (f64, f64), want: (f64, f64)| {
-            assert!((got.0 - want.0).abs() < 1e-14 && (got.1 - want.1).abs() < 1e-14, "{got:?} against {want:?}");
+            assert!(
+                (got.0 - want.0).abs() < 1e-14 && (got.1 - want.1).abs() < 1e-14,
+                "{got:?} against {want:?}"
+            );
         };
         // Skew: x axis from 0 to 2 and a y-directed segment over (0.5, −1..1, 1).
-        close(closest_on_segments(&v(0.0, 0.0, 0.0), &v(2.0, 0.0, 0.0), &v(0.5, -1.0, 1.0), &v(0.0, 2.0, 0.0)), (0.25, 0.5));
+        close(
+            closest_on_segments(
+                &v(0.0, 0.0, 0.0),
+                &v(2.0, 0.0, 0.0),
+                &v(0.5, -1.0, 1.0),
+                &v(0.0, 2.0, 0.0),
+            ),
+            (0.25, 0.5),
+        );
         // Beyond the end: the second segment's foot lies past s = 1.
-        close(closest_on_segments(&v(0.0, 0.0, 0.0), &v(1.0, 0.0, 0.0), &v(3.0, -1.0, 1.0), &v(0.0, 2.0, 0.0)), (1.0, 0.5));
+        close(
+            closest_on_segments(
+                &v(0.0, 0.0, 0.0),
+                &v(1.0, 0.0, 0.0),
+                &v(3.0, -1.0, 1.0),
+                &v(0.0, 2.0, 0.0),
+            ),
+            (1.0, 0.5),
+        );
         // Parallel, offset along their direction: s = 0 and t from it, clamped.
-        close(closest_on_segments(&v(0.0, 0.0, 0.0), &v(1.0, 0.0, 0.0), &v(0.5, 1.0, 0.0), &v(1.0, 0.0, 0.0)), (0.5, 0.0));
+        close(
+            closest_on_segments(
+                &v(0.0, 0.0, 0.0),
+                &v(1.0, 0.0, 0.0),
+                &v(0.5, 1.0, 0.0),
+                &v(1.0, 0.0, 0.0),
+            ),
+            (0.5, 0.0),
+        );
     }
-
 }

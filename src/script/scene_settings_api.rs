@@ -9,7 +9,9 @@ use crate::engine::choice::{self, Named};
 use crate::engine::ewald::EwaldMethod;
 use crate::engine::integrators::METHODS;
 use crate::engine::thermal::NoiseRoot;
-use crate::engine::{Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric, StericBody};
+use crate::engine::{
+    Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric, StericBody,
+};
 use rhai::{Dynamic, Engine, ImmutableString, INT};
 
 fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {

@@ -1,7 +1,10 @@
 //! Dormand-Prince 5(4) with embedded error estimate, FSAL, and Hairer's PI step-size controller
 //! (Hairer, Nørsett & Wanner, *Solving ODEs I*, II.4 and the `DOPRI5` code).
 
-use super::system::{check_state, fit, stalled, step_too_small, tolerance_failure, OdeSystem, Stats, StepFailure, Stepper};
+use super::system::{
+    check_state, fit, stalled, step_too_small, tolerance_failure, OdeSystem, Stats, StepFailure,
+    Stepper,
+};
 
 /// Stage times (the GPU backend takes the same tableau).
 pub const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];

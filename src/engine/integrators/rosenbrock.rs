@@ -11,7 +11,9 @@
 //! Stage equations (Hairer & Wanner, IV.7, with k including the factor h):
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
 
-use super::system::{check_state, fit, stalled, step_too_small, tolerance_failure, Problem, StepFailure};
+use super::system::{
+    check_state, fit, stalled, step_too_small, tolerance_failure, Problem, StepFailure,
+};
 use super::{OdeSystem, Stats, Stepper};
 use nalgebra::{DMatrix, DVector};
 
