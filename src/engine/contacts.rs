@@ -251,9 +251,10 @@ impl Steric {
         j: usize,
     ) -> Option<(f64, Vector3<f64>)> {
         let (p, d1) = (pos[2 * i], pos[2 * i + 1] - pos[2 * i]);
-        // Rod j placed at its image nearest rod i (midpoints by the minimum image).
+        // Rod j moved to its image nearest rod i (midpoints by the minimum image; open space: 0).
         let mid = |k: usize| (pos[2 * k] + pos[2 * k + 1]) * 0.5;
-        let shift = mid(i) - separation(periodic, mid(i) - mid(j)) - mid(j);
+        let d = mid(i) - mid(j);
+        let shift = d - separation(periodic, d);
         let (q, d2) = (pos[2 * j] + shift, pos[2 * j + 1] - pos[2 * j]);
         let (s, t) = closest_on_segments(&p, &d1, &q, &d2);
         let r = (p + d1 * s) - (q + d2 * t);
@@ -549,35 +550,33 @@ mod tests {
                 "{got:?} against {want:?}"
             );
         };
-        // Skew: x axis from 0 to 2 and a y-directed segment over (0.5, −1..1, 1).
-        close(
-            closest_on_segments(
-                &v(0.0, 0.0, 0.0),
-                &v(2.0, 0.0, 0.0),
-                &v(0.5, -1.0, 1.0),
-                &v(0.0, 2.0, 0.0),
+        for (p, d1, q, d2, want) in [
+            // Skew: x axis from 0 to 2 and a y-directed segment over (0.5, −1..1, 1).
+            (
+                v(0.0, 0.0, 0.0),
+                v(2.0, 0.0, 0.0),
+                v(0.5, -1.0, 1.0),
+                v(0.0, 2.0, 0.0),
+                (0.25, 0.5),
             ),
-            (0.25, 0.5),
-        );
-        // Beyond the end: the second segment's foot lies past s = 1.
-        close(
-            closest_on_segments(
-                &v(0.0, 0.0, 0.0),
-                &v(1.0, 0.0, 0.0),
-                &v(3.0, -1.0, 1.0),
-                &v(0.0, 2.0, 0.0),
+            // Beyond the end: the second segment's foot lies past s = 1.
+            (
+                v(0.0, 0.0, 0.0),
+                v(1.0, 0.0, 0.0),
+                v(3.0, -1.0, 1.0),
+                v(0.0, 2.0, 0.0),
+                (1.0, 0.5),
             ),
-            (1.0, 0.5),
-        );
-        // Parallel, offset along their direction: s = 0 and t from it, clamped.
-        close(
-            closest_on_segments(
-                &v(0.0, 0.0, 0.0),
-                &v(1.0, 0.0, 0.0),
-                &v(0.5, 1.0, 0.0),
-                &v(1.0, 0.0, 0.0),
+            // Parallel, offset along their direction: s = 0 and t from it, clamped.
+            (
+                v(0.0, 0.0, 0.0),
+                v(1.0, 0.0, 0.0),
+                v(0.5, 1.0, 0.0),
+                v(1.0, 0.0, 0.0),
+                (0.5, 0.0),
             ),
-            (0.5, 0.0),
-        );
+        ] {
+            close(closest_on_segments(&p, &d1, &q, &d2), want);
+        }
     }
 }

@@ -66,9 +66,6 @@ pub struct Dopri5 {
     fixed: Option<f64>,
     h: Option<f64>,
     fac_old: f64,
-    /// The contact (or other guard) failure that shrank the last step, if one did: the error
-    /// to stop with should the step then fall below what can advance the time.
-    guarded: Option<StepFailure>,
     fsal_valid: bool,
     k: [Vec<f64>; 7],
     tmp: Vec<f64>,
@@ -84,7 +81,6 @@ impl Dopri5 {
             fixed: None,
             h: None,
             fac_old: 1e-4,
-            guarded: None,
             fsal_valid: false,
             k: Default::default(),
             tmp: Vec::new(),
@@ -201,15 +197,9 @@ impl Stepper for Dopri5 {
         };
         let mut rejected_last = false;
         let mut rejects = 0;
-        let carried = self.guarded.take();
-        let mut guard_failure = None;
         loop {
             let span = t_end - t;
             let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
-            if !last && self.fixed.is_none() && step_too_small(h_try, t) {
-                self.h = Some(h_try);
-                return Err(stalled(t, h_try, guard_failure.or(carried)));
-            }
             for s in 1..7 {
                 for i in 0..n {
                     let mut acc = 0.0;
@@ -251,7 +241,6 @@ impl Stepper for Dopri5 {
                     y.copy_from_slice(&self.y_new);
                     self.k.swap(0, 6);
                     stats.steps += 1;
-                    self.guarded = guard_failure;
                     return Ok(t_new);
                 }
                 (true, Err(failure)) => {
@@ -262,8 +251,13 @@ impl Stepper for Dopri5 {
                         self.h = Some(h_try);
                         return Err(failure);
                     }
-                    guard_failure = Some(failure);
                     h = h_try * 0.25;
+                    // Crawling towards the event the guard refuses (spheres about to touch):
+                    // stop with it once the step no longer advances the time.
+                    if step_too_small(h, t) {
+                        self.h = Some(h_try);
+                        return Err(failure);
+                    }
                 }
                 (false, _) => {
                     stats.rejected += 1;
@@ -277,6 +271,9 @@ impl Stepper for Dopri5 {
                         1.0 / FAC_MIN
                     };
                     h = h_try / shrink;
+                    if step_too_small(h, t) {
+                        return Err(stalled(t_new, h));
+                    }
                 }
             }
             rejected_last = true;
@@ -286,7 +283,6 @@ impl Stepper for Dopri5 {
     fn reset(&mut self) {
         self.fsal_valid = false;
         self.fac_old = 1e-4;
-        self.guarded = None;
     }
 
     fn next_step(

@@ -56,9 +56,6 @@ pub struct Rosenbrock {
     rtol: f64,
     fixed: Option<f64>,
     h: Option<f64>,
-    /// The contact (or other guard) failure that shrank the last step, if one did: the error
-    /// to stop with should the step then fall below what can advance the time.
-    guarded: Option<StepFailure>,
     k: [Vec<f64>; 4],
     f: Vec<f64>,
     f0: Vec<f64>,
@@ -81,7 +78,6 @@ impl Rosenbrock {
             rtol,
             fixed: None,
             h: None,
-            guarded: None,
             k: Default::default(),
             f: Vec::new(),
             f0: Vec::new(),
@@ -235,15 +231,9 @@ impl Stepper for Rosenbrock {
             (None, None) => (t_end - t).min(1e-3 * (t_end - t).max(1e-9)),
         };
         let mut rejects = 0;
-        let carried = self.guarded.take();
-        let mut guard_failure = None;
         loop {
             let span = t_end - t;
             let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
-            if !last && self.fixed.is_none() && step_too_small(h_try, t) {
-                self.h = Some(h_try);
-                return Err(stalled(t, h_try, guard_failure.or(carried)));
-            }
             self.lus = (0..n.checked_div(bs).unwrap_or(0))
                 .map(|blk| {
                     let jb = &self.jac[blk * bs * bs..(blk + 1) * bs * bs];
@@ -274,7 +264,6 @@ impl Stepper for Rosenbrock {
                 (true, Ok(())) => {
                     y.copy_from_slice(&self.y_new);
                     stats.steps += 1;
-                    self.guarded = guard_failure;
                     let h_next = h_try * fac;
                     self.h = Some(if last && h_try < h {
                         h.max(h_next)
@@ -290,8 +279,13 @@ impl Stepper for Rosenbrock {
                     if fixed || rejects >= MAX_REJECTS {
                         return Err(failure);
                     }
-                    guard_failure = Some(failure);
                     h = h_try * 0.25;
+                    // Crawling towards the event the guard refuses (spheres about to touch):
+                    // stop with it once the step no longer advances the time.
+                    if step_too_small(h, t) {
+                        self.h = Some(h_try);
+                        return Err(failure);
+                    }
                 }
                 (false, _) => {
                     stats.rejected += 1;
@@ -300,6 +294,9 @@ impl Stepper for Rosenbrock {
                         return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
                     }
                     h = h_try * fac.min(0.9);
+                    if step_too_small(h, t) {
+                        return Err(stalled(t_new, h));
+                    }
                 }
             }
         }

@@ -251,10 +251,7 @@ impl Stroboscopic {
         y: &[f64],
         stats: &mut Stats,
     ) -> Result<Slope, StepFailure> {
-        let mut s = Samples::new(y);
-        while s.diffs.len() < self.degree {
-            self.sample(sys, t, &mut s, stats)?;
-        }
+        let s = self.samples(sys, t, y, self.degree, stats)?;
         Ok(s.slope(self.period, self.degree))
     }
 
@@ -271,11 +268,8 @@ impl Stroboscopic {
         y: &[f64],
         stats: &mut Stats,
     ) -> Result<Slope, StepFailure> {
-        let mut s = Samples::new(y);
         let lowest = self.degree.saturating_sub(1).max(2);
-        while s.diffs.len() <= lowest {
-            self.sample(sys, t, &mut s, stats)?;
-        }
+        let mut s = self.samples(sys, t, y, lowest + 1, stats)?;
         loop {
             let d = s.diffs.len();
             let (hi, below) = (s.slope(self.period, d), s.slope(self.period, d - 1));
@@ -295,6 +289,22 @@ impl Stroboscopic {
             }
             self.sample(sys, t, &mut s, stats)?;
         }
+    }
+
+    /// The first `n` stroboscopic points of `y`.
+    fn samples(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        n: usize,
+        stats: &mut Stats,
+    ) -> Result<Samples, StepFailure> {
+        let mut s = Samples::new(y);
+        for _ in 0..n {
+            self.sample(sys, t, &mut s, stats)?;
+        }
+        Ok(s)
     }
 
     /// One more stroboscopic point of `s`.

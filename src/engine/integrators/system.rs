@@ -228,15 +228,15 @@ pub(crate) fn tolerance_failure(time: f64, h: f64, rejects: u32) -> StepFailure 
 /// [`MIN_RELATIVE_INTERVAL`] of t, steps no longer advance the time measurably. An adaptive method
 /// that shrinks its step there is crawling towards an event it cannot pass (two spheres about to
 /// touch, where every larger step is refused by the contact guard), and stops with that event's
-/// error instead of spinning forever.
+/// error, or [`stalled`]'s, instead of spinning for ever.
 pub(crate) fn step_too_small(h: f64, t: f64) -> bool {
     h < MIN_RELATIVE_INTERVAL * t.abs()
 }
 
-/// The error of an adaptive method whose step fell below [`step_too_small`]'s floor: the guard's
-/// failure that forced it there, if one did, else the error estimate's.
-pub(crate) fn stalled(time: f64, h: f64, guard: Option<StepFailure>) -> StepFailure {
-    guard.unwrap_or_else(|| StepFailure {
+/// The error of an adaptive method whose error estimate shrank its step below
+/// [`step_too_small`]'s floor.
+pub(crate) fn stalled(time: f64, h: f64) -> StepFailure {
+    StepFailure {
         time,
         problem: Problem {
             swimmer: None,
@@ -247,7 +247,7 @@ pub(crate) fn stalled(time: f64, h: f64, guard: Option<StepFailure>) -> StepFail
                 .into(),
             fixes: Vec::new(),
         },
-    })
+    }
 }
 
 /// The finest interval (a step, a recorder's period) relative to the times it is used at: below
