@@ -1,9 +1,12 @@
-//! The vectorised, parallel pair kernel against the reference half-loop, and its independence of
-//! the thread count.
+//! The vectorised, parallel pair kernels (by rows, and each pair once in tiles) against the
+//! reference half-loop, and their independence of the thread count.
 
 use nalgebra::Vector3;
 use swimlab::bench::pairs::lattice;
-use swimlab::engine::pairs::{interaction_velocities, min_gap};
+use swimlab::engine::pairs::{
+    interaction_velocities, min_gap, row_velocities, symmetric_velocities, tile_rounds, SoaSpheres,
+    SYMMETRIC_SPHERES,
+};
 use swimlab::engine::Mobility;
 
 fn reference(m: Mobility, s: &swimlab::engine::pairs::SoaSpheres) -> Vec<Vector3<f64>> {
@@ -20,40 +23,93 @@ fn reference(m: Mobility, s: &swimlab::engine::pairs::SoaSpheres) -> Vec<Vector3
     u
 }
 
-// The two kernels sum the same ~N terms in different orders and group the RPY coefficients
-// differently: each u differs by a few ulps of the largest term, far below 1e-12 of |u|max.
+/// The kernels by name.
+type Kernel = fn(Mobility, f64, &SoaSpheres, &mut [[f64; 3]], bool);
+const KERNELS: [(&str, Kernel); 3] = [
+    ("by rows", row_velocities),
+    ("each pair once", symmetric_velocities),
+    ("chosen by size", interaction_velocities),
+];
+
+/// The largest component difference from the reference, and the largest reference component.
+fn error_against(r: &[Vector3<f64>], u: &[[f64; 3]]) -> (f64, f64) {
+    let scale = r.iter().map(|v| v.amax()).fold(0.0, f64::max);
+    let err = (0..r.len())
+        .flat_map(|i| (0..3).map(move |k| (i, k)))
+        .map(|(i, k)| (u[i][k] - r[i][k]).abs())
+        .fold(0.0, f64::max);
+    (err, scale)
+}
+
+// The kernels sum the same ~N terms in different orders and group the RPY coefficients
+// differently (and the tiled one fuses multiply-adds): each u differs by a few ulps of the largest
+// term, far below 1e-12 of |u|max. The sizes take partial lane blocks, one tile, several tiles
+// with a short last one, and both sides of SYMMETRIC_SPHERES.
 #[test]
-fn fast_kernel_matches_the_reference_to_round_off() {
+fn fast_kernels_match_the_reference_to_round_off() {
+    const { assert!(300 < SYMMETRIC_SPHERES && SYMMETRIC_SPHERES < 1100) };
     for m in [Mobility::Rpy, Mobility::Oseen] {
-        for n in [5usize, 67, 300] {
+        for n in [5usize, 67, 300, 1100] {
             let s = lattice(n);
             let r = reference(m, &s);
-            let mut u = vec![[0.0; 3]; n];
-            interaction_velocities(m, 1e-3, &s, &mut u, false);
-            let scale = r.iter().map(|v| v.amax()).fold(0.0, f64::max);
-            let err = (0..n)
-                .flat_map(|i| (0..3).map(move |k| (i, k)))
-                .map(|(i, k)| (u[i][k] - r[i][k]).abs())
-                .fold(0.0, f64::max);
-            assert!(err <= 1e-12 * scale, "{m:?} n = {n}: {err:e} of {scale:e}");
+            for (name, kernel) in KERNELS {
+                for parallel in [false, true] {
+                    let mut u = vec![[0.0; 3]; n];
+                    kernel(m, 1e-3, &s, &mut u, parallel);
+                    let (err, scale) = error_against(&r, &u);
+                    assert!(
+                        err <= 1e-12 * scale,
+                        "{name}, {m:?} n = {n}: {err:e} of {scale:e}"
+                    );
+                }
+            }
         }
     }
 }
 
-// Every row sums in a fixed order whatever runs it: serial, 1 thread or 2 threads give the same bits.
+// Every sphere's terms add up in a fixed order whatever runs them: serial, 1, 2 or 3 threads
+// give the same bits, by rows and by tiles (33 tiles at n = 4,200: rounds of 16 tile pairs).
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
-    let s = lattice(1000);
-    let mut serial = vec![[0.0; 3]; s.len()];
-    interaction_velocities(Mobility::Rpy, 1e-3, &s, &mut serial, false);
-    for threads in [1, 2, 3] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let mut u = vec![[0.0; 3]; s.len()];
-        pool.install(|| interaction_velocities(Mobility::Rpy, 1e-3, &s, &mut u, true));
-        assert_eq!(u, serial, "{threads} threads");
+    for n in [1000, 4200] {
+        let s = lattice(n);
+        for (name, kernel) in KERNELS {
+            let mut serial = vec![[0.0; 3]; n];
+            kernel(Mobility::Rpy, 1e-3, &s, &mut serial, false);
+            for threads in [1, 2, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut u = vec![[0.0; 3]; n];
+                pool.install(|| kernel(Mobility::Rpy, 1e-3, &s, &mut u, true));
+                assert_eq!(u, serial, "{name}, n = {n}, {threads} threads");
+            }
+        }
+    }
+}
+
+// The rounds pair every two tiles exactly once, and no tile twice in a round (so a round's tile
+// pairs write disjoint accumulators).
+#[test]
+fn tile_rounds_meet_every_pair_once() {
+    for t in 0..=13 {
+        let mut met = vec![vec![0; t]; t];
+        for round in tile_rounds(t) {
+            let mut busy = vec![false; t];
+            for (a, b) in round {
+                assert!(a < b && b < t, "t = {t}: ({a}, {b})");
+                assert!(!busy[a] && !busy[b], "t = {t}: a tile twice in a round");
+                busy[a] = true;
+                busy[b] = true;
+                met[a][b] += 1;
+            }
+        }
+        for (a, row) in met.iter().enumerate() {
+            for (b, &count) in row.iter().enumerate().skip(a + 1) {
+                assert_eq!(count, 1, "t = {t}: tiles {a} and {b}");
+            }
+        }
     }
 }
 
@@ -81,27 +137,35 @@ fn min_gap_finds_the_closest_pair() {
 }
 
 // Overlapping pairs leave the vector loop and take the scalar overlapping-sphere (Zuk et al.)
-// form; the result must still be the reference's to round-off, on 1 or 2 threads alike.
+// form; the result must still be the reference's to round-off, in every kernel, on 1 or 2
+// threads alike. At n = 1,100 the pairs lie within a tile (17, 40-41, 90-91) and across tiles
+// (150 with 17, 1050 with 3).
 #[test]
-fn overlapping_spheres_take_the_overlap_form_in_the_fast_kernel() {
-    let mut s = lattice(300);
-    // 17 and 150 overlap partly; 40 sits inside 41 (|r| < |a40 − a41|); 90 and 91 at one point.
-    for (j, i, dx) in [(150, 17, 0.6e-6), (40, 41, 0.05e-6), (90, 91, 0.0)] {
-        s.x[j] = s.x[i] + dx;
-        s.y[j] = s.y[i];
-        s.z[j] = s.z[i];
-    }
-    s.set_radius(41, 1.0e-6);
-    s.set_radius(40, 0.5e-6);
-    let r = reference(Mobility::Rpy, &s);
-    let scale = r.iter().map(|v| v.amax()).fold(0.0, f64::max);
-    for parallel in [false, true] {
-        let mut u = vec![[0.0; 3]; s.len()];
-        interaction_velocities(Mobility::Rpy, 1e-3, &s, &mut u, parallel);
-        for (i, ri) in r.iter().enumerate() {
-            for k in 0..3 {
-                let err = (u[i][k] - ri[k]).abs();
-                assert!(err <= 1e-12 * scale, "sphere {i}: {err:e} of {scale:e}");
+fn overlapping_spheres_take_the_overlap_form_in_the_fast_kernels() {
+    for n in [300, 1100] {
+        let mut s = lattice(n);
+        // 17 and 150 overlap partly; 40 sits inside 41 (|r| < |a40 − a41|); 90 and 91 at one point.
+        let mut moves = vec![(150, 17, 0.6e-6), (40, 41, 0.05e-6), (90, 91, 0.0)];
+        if n > 1050 {
+            moves.push((1050, 3, 0.3e-6));
+        }
+        for (j, i, dx) in moves {
+            s.x[j] = s.x[i] + dx;
+            s.y[j] = s.y[i];
+            s.z[j] = s.z[i];
+        }
+        s.set_radius(41, 1.0e-6);
+        s.set_radius(40, 0.5e-6);
+        let r = reference(Mobility::Rpy, &s);
+        for (name, kernel) in KERNELS {
+            for parallel in [false, true] {
+                let mut u = vec![[0.0; 3]; n];
+                kernel(Mobility::Rpy, 1e-3, &s, &mut u, parallel);
+                let (err, scale) = error_against(&r, &u);
+                assert!(
+                    err <= 1e-12 * scale,
+                    "{name}, n = {n}: {err:e} of {scale:e}"
+                );
             }
         }
     }

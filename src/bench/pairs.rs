@@ -4,7 +4,7 @@
 
 use super::table::Table;
 use crate::engine::mobility::Mobility;
-use crate::engine::pairs::{interaction_velocities, SoaSpheres};
+use crate::engine::pairs::{interaction_velocities, row_velocities, SoaSpheres};
 use std::time::Instant;
 
 /// Interactions per second per core that the arithmetic allows (issue 7's bound).
@@ -33,11 +33,19 @@ pub fn lattice(n: usize) -> SoaSpheres {
 
 /// Median over `repeats` of the seconds one product takes.
 fn time_product(s: &SoaSpheres, parallel: bool, repeats: usize) -> f64 {
+    time_kernel(interaction_velocities, s, parallel, repeats)
+}
+
+/// A pair kernel's signature.
+type PairKernel = fn(Mobility, f64, &SoaSpheres, &mut [[f64; 3]], bool);
+
+/// Median over `repeats` of the seconds one product of `kernel` takes.
+fn time_kernel(kernel: PairKernel, s: &SoaSpheres, parallel: bool, repeats: usize) -> f64 {
     let mut u = vec![[0.0; 3]; s.len()];
     let mut times: Vec<f64> = (0..repeats)
         .map(|_| {
             let start = Instant::now();
-            interaction_velocities(Mobility::Rpy, 1e-3, s, &mut u, parallel);
+            kernel(Mobility::Rpy, 1e-3, s, &mut u, parallel);
             std::hint::black_box(&u);
             start.elapsed().as_secs_f64()
         })
@@ -73,6 +81,8 @@ pub fn run(n: usize, repeats: usize) -> Table {
         ]);
     };
     row("1 (serial)".into(), serial, 1);
+    let by_rows = time_kernel(row_velocities, &s, false, repeats);
+    row("1 (serial, by rows)".into(), by_rows, 1);
     for threads in 1..=cores {
         let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
             Ok(p) => p,
