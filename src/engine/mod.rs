@@ -29,6 +29,7 @@ pub mod plan;
 pub mod recorder;
 pub mod rigid;
 pub mod scene;
+pub mod simd;
 pub mod simulation;
 mod spheres;
 pub mod stepping;

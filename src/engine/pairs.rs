@@ -23,6 +23,7 @@
 
 use super::mobility::Mobility;
 use super::periodic::PeriodicBox;
+use super::simd::vector_dispatch;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -221,45 +222,14 @@ fn lane_sum(a: &[f64; LANES]) -> f64 {
     ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]))
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn rows_avx512(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
-    rows_impl(s, k, first, u)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn rows_avx2(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
-    rows_impl(s, k, first, u)
-}
-
 /// The widest vector unit this CPU has, for the report.
 pub fn vector_unit() -> &'static str {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::is_x86_feature_detected!("avx512f") {
-            return "avx512f";
-        }
-        if std::is_x86_feature_detected!("avx2") {
-            return "avx2";
-        }
-    }
-    "baseline"
+    super::simd::vector_unit()
 }
 
-fn rows(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { rows_avx512(s, k, first, u) };
-        }
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { rows_avx2(s, k, first, u) };
-        }
-    }
-    rows_impl(s, k, first, u)
+vector_dispatch! {
+    /// [`rows_impl`] in the widest vector unit present.
+    fn rows(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) = rows_impl;
 }
 
 /// Spheres per tile of the symmetric kernel: n/32, within these bounds (multiples of [`LANES`]).
@@ -436,41 +406,9 @@ fn tile_pairs(s: &SoaSpheres, k: Kernel, rows: Cols<'_>, cols: Option<Cols<'_>>)
     masked
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,fma")]
-unsafe fn tile_pairs_avx512(
-    s: &SoaSpheres,
-    k: Kernel,
-    r: Cols<'_>,
-    c: Option<Cols<'_>>,
-) -> Vec<usize> {
-    tile_pairs(s, k, r, c)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn tile_pairs_avx2(
-    s: &SoaSpheres,
-    k: Kernel,
-    r: Cols<'_>,
-    c: Option<Cols<'_>>,
-) -> Vec<usize> {
-    tile_pairs(s, k, r, c)
-}
-
-fn tile_pairs_dispatch(s: &SoaSpheres, k: Kernel, r: Cols<'_>, c: Option<Cols<'_>>) -> Vec<usize> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { tile_pairs_avx512(s, k, r, c) };
-        }
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { tile_pairs_avx2(s, k, r, c) };
-        }
-    }
-    tile_pairs(s, k, r, c)
+vector_dispatch! {
+    /// [`tile_pairs`] in the widest vector unit present.
+    fn tile_pairs_dispatch(s: &SoaSpheres, k: Kernel, r: Cols<'_>, c: Option<Cols<'_>>) -> Vec<usize> = tile_pairs;
 }
 
 /// The accumulators split into tiles of `tile` spheres.
