@@ -139,7 +139,8 @@ enum BenchKind {
     /// up to 1,024), transfers included, both models; the crossover and the "auto" calibration.
     Backends,
     /// The CPU pair kernel: RPY interactions per second at N = 4,096 spheres, serial and on 1 …
-    /// all cores, against the ~1e9 per core bound.
+    /// all cores, against the ~1e9 per core bound; also the row kernel serially, side by side.
+    /// Against PyStokes: benches/pystokes/README.md.
     Pairs,
     /// Cost per stroke period against the number of swimmers (2 … 4,096; --quick: up to 256),
     /// microscopic and averaged models on the CPU (the averaged with a cutoff up to 8x larger)

@@ -1,6 +1,7 @@
 //! The fast pair kernel ([`crate::engine::pairs`]): RPY pair interactions per second at
 //! N = 4,096 spheres, serial and on 1 … all cores, against the ~1e9 per core bound (≈36 flops and
-//! one reciprocal square root per H_ij·F_j).
+//! one reciprocal square root per H_ij·F_j); and the row kernel ([`row_velocities`]) serially in
+//! the same run, the comparison of the each-pair-once form against the rows.
 
 use super::table::Table;
 use crate::engine::mobility::Mobility;
