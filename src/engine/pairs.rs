@@ -252,51 +252,49 @@ struct Cols<'a> {
     z: &'a mut [f64],
 }
 
-/// The half row of sphere `i` against the spheres of `c` (all different from i): adds H_ij F_i
-/// to each column j's accumulators and returns Σ_j H_ij F_j and the count of pairs masked as
-/// overlapping (RPY: r ≤ a_i + a_j; both models: coincident spheres).
+/// What the each-pair-once kernel reads: the spheres and, per sphere, the
+/// radius counted for overlaps (zero for Oseen) and (c3/c1)·a², the finite-size term scaled by
+/// 8πμ. The sums carry H/c1 (c1 = 1/(8πμ)): the far-field coefficient is then 1/r itself, and
+/// the result is scaled by c1 once per sphere.
+#[derive(Clone, Copy)]
+struct Tiled<'a> {
+    s: &'a SoaSpheres,
+    reach_a: &'a [f64],
+    a2s: &'a [f64],
+}
+
+/// The half row of sphere `i` against the spheres of `c` (all different from i): adds
+/// H_ij F_i / c1 to each column j's accumulators and returns Σ_j H_ij F_j / c1 and the count of
+/// pairs masked as overlapping (RPY: r ≤ a_i + a_j; both models: coincident spheres). Each
+/// accumulator takes its terms as two fused multiply-adds (exact in every vector width, and in
+/// software without one): the result depends on neither.
 #[inline(always)]
-fn half_row(s: &SoaSpheres, k: Kernel, i: usize, c: &mut Cols<'_>) -> ([f64; 3], f64) {
-    let (c1, c3) = (k.c1, k.c3);
-    let reach = if c3 != 0.0 { 1.0 } else { 0.0 };
-    let (xi, yi, zi, ai, ai2) = (s.x[i], s.y[i], s.z[i], s.a[i] * reach, s.a2[i]);
+fn half_row(t: Tiled<'_>, i: usize, c: &mut Cols<'_>) -> ([f64; 3], f64) {
+    let s = t.s;
+    let (xi, yi, zi, ai, ai2) = (s.x[i], s.y[i], s.z[i], t.reach_a[i], t.a2s[i]);
     let (fxi, fyi, fzi) = (s.fx[i], s.fy[i], s.fz[i]);
-    // H_ij = cf 1 + g r rᵀ; returns (H_ij F_j, H_ij F_i, masked). Products and sums fuse (exact
-    // in every vector width, and in software without one): the result depends on neither.
+    // H_ij / c1 = cf 1 + g r rᵀ: returns (r, cf, g (r·F_j), g (r·F_i), masked).
     #[allow(clippy::too_many_arguments)]
     let term = |x: f64, y: f64, z: f64, a: f64, a2: f64, fx: f64, fy: f64, fz: f64| {
         let (rx, ry, rz) = (xi - x, yi - y, zi - z);
         let r2 = rx.mul_add(rx, ry.mul_add(ry, rz * rz));
         let inv = 1.0 / r2.sqrt();
-        let contact = ai + a * reach;
+        let contact = ai + a;
         let separated = r2 > contact * contact;
         let inv_r = if separated { inv } else { 0.0 };
         let masked = if separated { 0.0 } else { 1.0 };
         let inv_r2 = inv_r * inv_r;
-        let o = c1 * inv_r;
-        let f3 = c3 * (ai2 + a2) * inv_r * inv_r2;
-        let cf = o + f3;
-        let g = (-3.0f64).mul_add(f3, o) * inv_r2;
+        let f3 = (ai2 + a2) * inv_r * inv_r2;
+        let cf = inv_r + f3;
+        let g = (-3.0f64).mul_add(f3, inv_r) * inv_r2;
         let gj = g * rx.mul_add(fx, ry.mul_add(fy, rz * fz));
         let gi = g * rx.mul_add(fxi, ry.mul_add(fyi, rz * fzi));
-        (
-            [
-                cf.mul_add(fx, gj * rx),
-                cf.mul_add(fy, gj * ry),
-                cf.mul_add(fz, gj * rz),
-            ],
-            [
-                cf.mul_add(fxi, gi * rx),
-                cf.mul_add(fyi, gi * ry),
-                cf.mul_add(fzi, gi * rz),
-            ],
-            masked,
-        )
+        ([rx, ry, rz], cf, gj, gi, masked)
     };
     let n = c.x.len();
     let r = c.base..c.base + n;
     let (x, y, z) = (&s.x[r.clone()], &s.y[r.clone()], &s.z[r.clone()]);
-    let (a, a2) = (&s.a[r.clone()], &s.a2[r.clone()]);
+    let (a, a2) = (&t.reach_a[r.clone()], &t.a2s[r.clone()]);
     let (fx, fy, fz) = (&s.fx[r.clone()], &s.fy[r.clone()], &s.fz[r]);
     let (ux, uy, uz) = (&mut *c.x, &mut *c.y, &mut *c.z);
     let blocks = n / LANES;
@@ -314,46 +312,45 @@ fn half_row(s: &SoaSpheres, k: Kernel, i: usize, c: &mut Cols<'_>) -> ([f64; 3],
         ) else {
             continue;
         };
-        let lanes =
-            |v: &[f64]| -> [f64; LANES] { v[o..o + LANES].try_into().unwrap_or([0.0; LANES]) };
+        let lanes = |v: &[f64]| -> [f64; LANES] {
+            v[o..o + LANES].try_into().unwrap_or([0.0; LANES])
+        };
         let (xb, yb, zb, ab, a2b) = (lanes(x), lanes(y), lanes(z), lanes(a), lanes(a2));
         let (fxb, fyb, fzb) = (lanes(fx), lanes(fy), lanes(fz));
         let (mut vx, mut vy, mut vz) = (*cx, *cy, *cz);
         for l in 0..LANES {
-            let (ti, tj, m) = term(xb[l], yb[l], zb[l], ab[l], a2b[l], fxb[l], fyb[l], fzb[l]);
-            ax[l] += ti[0];
-            ay[l] += ti[1];
-            az[l] += ti[2];
-            vx[l] += tj[0];
-            vy[l] += tj[1];
-            vz[l] += tj[2];
+            let (rv, cf, gj, gi, m) =
+                term(xb[l], yb[l], zb[l], ab[l], a2b[l], fxb[l], fyb[l], fzb[l]);
+            ax[l] = gj.mul_add(rv[0], cf.mul_add(fxb[l], ax[l]));
+            ay[l] = gj.mul_add(rv[1], cf.mul_add(fyb[l], ay[l]));
+            az[l] = gj.mul_add(rv[2], cf.mul_add(fzb[l], az[l]));
+            vx[l] = gi.mul_add(rv[0], cf.mul_add(fxi, vx[l]));
+            vy[l] = gi.mul_add(rv[1], cf.mul_add(fyi, vy[l]));
+            vz[l] = gi.mul_add(rv[2], cf.mul_add(fzi, vz[l]));
             masked[l] += m;
         }
         (*cx, *cy, *cz) = (vx, vy, vz);
     }
     for j in blocks * LANES..n {
-        let (ti, tj, m) = term(x[j], y[j], z[j], a[j], a2[j], fx[j], fy[j], fz[j]);
-        ax[0] += ti[0];
-        ay[0] += ti[1];
-        az[0] += ti[2];
-        ux[j] += tj[0];
-        uy[j] += tj[1];
-        uz[j] += tj[2];
+        let (rv, cf, gj, gi, m) = term(x[j], y[j], z[j], a[j], a2[j], fx[j], fy[j], fz[j]);
+        ax[0] = gj.mul_add(rv[0], cf.mul_add(fx[j], ax[0]));
+        ay[0] = gj.mul_add(rv[1], cf.mul_add(fy[j], ay[0]));
+        az[0] = gj.mul_add(rv[2], cf.mul_add(fz[j], az[0]));
+        ux[j] = gi.mul_add(rv[0], cf.mul_add(fxi, ux[j]));
+        uy[j] = gi.mul_add(rv[1], cf.mul_add(fyi, uy[j]));
+        uz[j] = gi.mul_add(rv[2], cf.mul_add(fzi, uz[j]));
         masked[0] += m;
     }
-    (
-        [lane_sum(&ax), lane_sum(&ay), lane_sum(&az)],
-        lane_sum(&masked),
-    )
+    ([lane_sum(&ax), lane_sum(&ay), lane_sum(&az)], lane_sum(&masked))
 }
 
 /// The spheres of `c` that sphere `i` overlaps (the pairs [`half_row`] masked).
 #[cold]
-fn overlapping_in(s: &SoaSpheres, k: Kernel, i: usize, c: &Cols<'_>, out: &mut Vec<usize>) {
-    let reach = if k.c3 != 0.0 { 1.0 } else { 0.0 };
+fn overlapping_in(t: Tiled<'_>, i: usize, c: &Cols<'_>, out: &mut Vec<usize>) {
+    let s = t.s;
     for j in c.base..c.base + c.x.len() {
         let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
-        let contact = (s.a[i] + s.a[j]) * reach;
+        let contact = t.reach_a[i] + t.reach_a[j];
         if rx * rx + ry * ry + rz * rz <= contact * contact {
             out.push(j);
         }
@@ -363,20 +360,20 @@ fn overlapping_in(s: &SoaSpheres, k: Kernel, i: usize, c: &Cols<'_>, out: &mut V
 /// Every pair of the tiles `rows` and `cols` (both given by their accumulators), or of the tile
 /// `rows` with itself when `cols` is `None`; returns the spheres of masked pairs.
 #[inline(always)]
-fn tile_pairs(s: &SoaSpheres, k: Kernel, rows: Cols<'_>, cols: Option<Cols<'_>>) -> Vec<usize> {
+fn tile_pairs(t: Tiled<'_>, rows: Cols<'_>, cols: Option<Cols<'_>>) -> Vec<usize> {
     let mut masked = Vec::new();
     let Cols { base, x, y, z } = rows;
     match cols {
         Some(mut c) => {
             for r in 0..x.len() {
                 let i = base + r;
-                let (u, m) = half_row(s, k, i, &mut c);
+                let (u, m) = half_row(t, i, &mut c);
                 x[r] += u[0];
                 y[r] += u[1];
                 z[r] += u[2];
                 if m > 0.0 {
                     masked.push(i);
-                    overlapping_in(s, k, i, &c, &mut masked);
+                    overlapping_in(t, i, &c, &mut masked);
                 }
             }
         }
@@ -392,13 +389,13 @@ fn tile_pairs(s: &SoaSpheres, k: Kernel, rows: Cols<'_>, cols: Option<Cols<'_>>)
                     y: yc,
                     z: zc,
                 };
-                let (u, m) = half_row(s, k, i, &mut c);
+                let (u, m) = half_row(t, i, &mut c);
                 xr[r] += u[0];
                 yr[r] += u[1];
                 zr[r] += u[2];
                 if m > 0.0 {
                     masked.push(i);
-                    overlapping_in(s, k, i, &c, &mut masked);
+                    overlapping_in(t, i, &c, &mut masked);
                 }
             }
         }
@@ -408,7 +405,7 @@ fn tile_pairs(s: &SoaSpheres, k: Kernel, rows: Cols<'_>, cols: Option<Cols<'_>>)
 
 vector_dispatch! {
     /// [`tile_pairs`] in the widest vector unit present.
-    fn tile_pairs_dispatch(s: &SoaSpheres, k: Kernel, r: Cols<'_>, c: Option<Cols<'_>>) -> Vec<usize> = tile_pairs;
+    fn tile_pairs_dispatch(t: Tiled<'_>, r: Cols<'_>, c: Option<Cols<'_>>) -> Vec<usize> = tile_pairs;
 }
 
 /// The accumulators split into tiles of `tile` spheres.
@@ -469,6 +466,15 @@ pub fn symmetric_velocities(
     let (c1, c3) = prefactors(m, mu);
     let k = Kernel { m, mu, c1, c3 };
     let n = s.len();
+    // Oseen has no finite size: nothing but coincident spheres is masked.
+    let reach = if c3 != 0.0 { 1.0 } else { 0.0 };
+    let reach_a: Vec<f64> = s.a.iter().map(|a| a * reach).collect();
+    let a2s: Vec<f64> = s.a2.iter().map(|a2| c3 / c1 * a2).collect();
+    let kt = Tiled {
+        s,
+        reach_a: &reach_a,
+        a2s: &a2s,
+    };
     let (mut ux, mut uy, mut uz) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let tile = (n / 32).next_multiple_of(LANES).clamp(MIN_TILE, MAX_TILE);
     let t = n.div_ceil(tile);
@@ -477,13 +483,13 @@ pub fn symmetric_velocities(
         if parallel {
             tasks
                 .into_par_iter()
-                .map(|(r, c)| tile_pairs_dispatch(s, k, r, c))
+                .map(|(r, c)| tile_pairs_dispatch(kt, r, c))
                 .flatten()
                 .collect()
         } else {
             tasks
                 .into_iter()
-                .flat_map(|(r, c)| tile_pairs_dispatch(s, k, r, c))
+                .flat_map(|(r, c)| tile_pairs_dispatch(kt, r, c))
                 .collect()
         }
     };
@@ -502,7 +508,7 @@ pub fn symmetric_velocities(
         masked.extend(run(tasks));
     }
     for (i, out) in u.iter_mut().enumerate() {
-        *out = [ux[i], uy[i], uz[i]];
+        *out = [c1 * ux[i], c1 * uy[i], c1 * uz[i]];
     }
     masked.sort_unstable();
     masked.dedup();
