@@ -312,9 +312,8 @@ fn half_row(t: Tiled<'_>, i: usize, c: &mut Cols<'_>) -> ([f64; 3], f64) {
         ) else {
             continue;
         };
-        let lanes = |v: &[f64]| -> [f64; LANES] {
-            v[o..o + LANES].try_into().unwrap_or([0.0; LANES])
-        };
+        let lanes =
+            |v: &[f64]| -> [f64; LANES] { v[o..o + LANES].try_into().unwrap_or([0.0; LANES]) };
         let (xb, yb, zb, ab, a2b) = (lanes(x), lanes(y), lanes(z), lanes(a), lanes(a2));
         let (fxb, fyb, fzb) = (lanes(fx), lanes(fy), lanes(fz));
         let (mut vx, mut vy, mut vz) = (*cx, *cy, *cz);
@@ -341,7 +340,10 @@ fn half_row(t: Tiled<'_>, i: usize, c: &mut Cols<'_>) -> ([f64; 3], f64) {
         uz[j] = gi.mul_add(rv[2], cf.mul_add(fzi, uz[j]));
         masked[0] += m;
     }
-    ([lane_sum(&ax), lane_sum(&ay), lane_sum(&az)], lane_sum(&masked))
+    (
+        [lane_sum(&ax), lane_sum(&ay), lane_sum(&az)],
+        lane_sum(&masked),
+    )
 }
 
 /// The spheres of `c` that sphere `i` overlaps (the pairs [`half_row`] masked).

@@ -219,7 +219,8 @@ struct Acc<'a> {
 
 /// The rates of one side of a pair: the swimmer's own prefactors, the phase sine as seen from it,
 /// ξ = ℓ/D, its ss = D̂·N_own and rr = D̂·N_partner with D̂ pointing from the partner to it, the
-/// shared brackets q, J-K and I, its orientation and D̂: (dR_H/dt, T).
+/// shared brackets q, J-K and I, its orientation and D̂: its accumulators of (dR_H/dt, T) with
+/// the pair's terms added (as fused multiply-adds).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn side(
@@ -233,12 +234,13 @@ fn side(
     i_br: f64,
     n: [f64; 3],
     h: [f64; 3],
+    acc: [f64; 6],
 ) -> [f64; 6] {
     let [kj, kl, ki, kk] = k;
-    let xi3 = xi * xi * xi;
-    let xi4 = xi3 * xi;
+    let sx3 = sin * xi * xi * xi;
+    let sx4 = sx3 * xi;
     let (ss2, rr2) = (ss * ss, rr * rr);
-    let j = kj * sin * xi4;
+    let j = kj * sx4;
     // 2 ss + 4 q rr − 10 ss rr²
     let jn = j * (-10.0 * ss).mul_add(rr2, (4.0 * q).mul_add(rr, 2.0 * ss));
     let jd = j * jk;
@@ -248,16 +250,16 @@ fn side(
         (-21.0f64).mul_add(rr2, (-7.0f64).mul_add(ss2, (6.0 * q).mul_add(q, 3.0))),
     );
     let l_br = ss.mul_add(l_ss, rr * q * (-42.0f64).mul_add(ss2, 6.0));
-    let l = kl * sin * xi4 * xi * l_br;
-    let vn = (ki * sin * xi3).mul_add(i_br, jn);
-    let td = (kk * sin * xi4).mul_add(jk, l);
+    let l = kl * sx4 * xi * l_br;
+    let vn = (ki * sx3).mul_add(i_br, jn);
+    let td = (kk * sx4).mul_add(jk, l);
     [
-        n[0].mul_add(vn, h[0] * jd),
-        n[1].mul_add(vn, h[1] * jd),
-        n[2].mul_add(vn, h[2] * jd),
-        h[0] * td,
-        h[1] * td,
-        h[2] * td,
+        n[0].mul_add(vn, h[0].mul_add(jd, acc[0])),
+        n[1].mul_add(vn, h[1].mul_add(jd, acc[1])),
+        n[2].mul_add(vn, h[2].mul_add(jd, acc[2])),
+        h[0].mul_add(td, acc[3]),
+        h[1].mul_add(td, acc[4]),
+        h[2].mul_add(td, acc[5]),
     ]
 }
 
@@ -289,6 +291,8 @@ fn pair_term(
     cs: f64,
     kr: [f64; 4],
     ell_r: f64,
+    mine: [f64; 6],
+    theirs: [f64; 6],
 ) -> ([f64; 6], [f64; 6]) {
     let (dx, dy, dz) = (p.at[0] - x, p.at[1] - y, p.at[2] - z);
     let d2 = dx.mul_add(dx, dy.mul_add(dy, dz * dz));
@@ -313,10 +317,10 @@ fn pair_term(
         rr2,
         (-6.0f64).mul_add(qsr, (-3.0f64).mul_add(ss2 + rr2, 1.0)),
     );
-    let mine = side(p.k, sin, p.ell * inv, ss, rr, q, jk, i_br, a, h);
+    let mine = side(p.k, sin, p.ell * inv, ss, rr, q, jk, i_br, a, h, mine);
     // Seen from the partner: D̂ and the phase difference change sign, ss and rr swap roles.
     let hr = [-h[0], -h[1], -h[2]];
-    let theirs = side(kr, -sin, ell_r * inv, -rr, -ss, q, jk, i_br, b, hr);
+    let theirs = side(kr, -sin, ell_r * inv, -rr, -ss, q, jk, i_br, b, hr, theirs);
     (mine, theirs)
 }
 
@@ -335,8 +339,8 @@ fn half_row(sys: &AveragedSystem, k: &RowConstants, s: usize, c: &mut Acc<'_>) -
         skip_zero: sys.skip_zero_phase,
         cutoff2: sys.cutoff2,
     };
-    let term = |x, y, z, bx, by, bz, sn, cs, kr, ell_r| {
-        pair_term(&p, x, y, z, bx, by, bz, sn, cs, kr, ell_r)
+    let term = |x, y, z, bx, by, bz, sn, cs, kr, ell_r, mine, theirs| {
+        pair_term(&p, x, y, z, bx, by, bz, sn, cs, kr, ell_r, mine, theirs)
     };
     let n = c.a[0].len();
     let r = c.base..c.base + n;
@@ -376,10 +380,12 @@ fn half_row(sys: &AveragedSystem, k: &RowConstants, s: usize, c: &mut Acc<'_>) -
                 csb[l],
                 [kjb[l], klb[l], kib[l], kkb[l]],
                 ellb[l],
+                std::array::from_fn(|m| acc[m][l]),
+                std::array::from_fn(|m| theirs[m][l]),
             );
             for m in 0..6 {
-                acc[m][l] += mine[m];
-                theirs[m][l] += other[m];
+                acc[m][l] = mine[m];
+                theirs[m][l] = other[m];
             }
         }
         for (m, col) in theirs.iter().enumerate() {
@@ -398,10 +404,12 @@ fn half_row(sys: &AveragedSystem, k: &RowConstants, s: usize, c: &mut Acc<'_>) -
             cs[j],
             [kj[j], kl[j], ki[j], kk[j]],
             ell[j],
+            std::array::from_fn(|m| acc[m][0]),
+            std::array::from_fn(|m| c.a[m][j]),
         );
         for m in 0..6 {
-            acc[m][0] += mine[m];
-            c.a[m][j] += other[m];
+            acc[m][0] = mine[m];
+            c.a[m][j] = other[m];
         }
     }
     acc.map(|a| lane_sum(&a))
