@@ -359,6 +359,26 @@ fn overlapping_in(t: Tiled<'_>, i: usize, c: &Cols<'_>, out: &mut Vec<usize>) {
     }
 }
 
+/// Sphere `i`'s half row against `c`, added to its accumulators `own`; the spheres of masked
+/// pairs are pushed to `masked`.
+#[inline(always)]
+fn add_half_row(
+    t: Tiled<'_>,
+    i: usize,
+    c: &mut Cols<'_>,
+    own: [&mut f64; 3],
+    masked: &mut Vec<usize>,
+) {
+    let (u, m) = half_row(t, i, c);
+    for (o, v) in own.into_iter().zip(u) {
+        *o += v;
+    }
+    if m > 0.0 {
+        masked.push(i);
+        overlapping_in(t, i, c, masked);
+    }
+}
+
 /// Every pair of the tiles `rows` and `cols` (both given by their accumulators), or of the tile
 /// `rows` with itself when `cols` is `None`; returns the spheres of masked pairs.
 #[inline(always)]
@@ -368,37 +388,28 @@ fn tile_pairs(t: Tiled<'_>, rows: Cols<'_>, cols: Option<Cols<'_>>) -> Vec<usize
     match cols {
         Some(mut c) => {
             for r in 0..x.len() {
-                let i = base + r;
-                let (u, m) = half_row(t, i, &mut c);
-                x[r] += u[0];
-                y[r] += u[1];
-                z[r] += u[2];
-                if m > 0.0 {
-                    masked.push(i);
-                    overlapping_in(t, i, &c, &mut masked);
-                }
+                add_half_row(
+                    t,
+                    base + r,
+                    &mut c,
+                    [&mut x[r], &mut y[r], &mut z[r]],
+                    &mut masked,
+                );
             }
         }
         None => {
             for r in 0..x.len() {
-                let i = base + r;
                 let (xr, xc) = x.split_at_mut(r + 1);
                 let (yr, yc) = y.split_at_mut(r + 1);
                 let (zr, zc) = z.split_at_mut(r + 1);
+                let (i, own) = (base + r, [&mut xr[r], &mut yr[r], &mut zr[r]]);
                 let mut c = Cols {
                     base: i + 1,
                     x: xc,
                     y: yc,
                     z: zc,
                 };
-                let (u, m) = half_row(t, i, &mut c);
-                xr[r] += u[0];
-                yr[r] += u[1];
-                zr[r] += u[2];
-                if m > 0.0 {
-                    masked.push(i);
-                    overlapping_in(t, i, &c, &mut masked);
-                }
+                add_half_row(t, i, &mut c, own, &mut masked);
             }
         }
     }
