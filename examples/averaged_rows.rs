@@ -1,6 +1,6 @@
 //! One averaged right-hand side of a lattice of S swimmers (orientations turned out of line, so
-//! the 3D rows run): scalar rows, vector-lane rows, and vector lanes with each pair once for both
-//! swimmers (tiled), per swimmer pair and core, on 1 and all threads: `cargo run --release --example averaged_rows -- 4096`. Compare with the sphere
+//! the 3D rows run), scalar rows against vector-lane rows, per swimmer pair and core, on 1 and
+//! all threads: `cargo run --release --example averaged_rows -- 4096`. Compare with the sphere
 //! kernel's interactions per second from `swimlab bench pairs` in the same session.
 use std::time::Instant;
 use swimlab::engine::averaged::AveragedSystem;
@@ -30,14 +30,9 @@ fn main() {
             .num_threads(threads)
             .build()
             .unwrap();
-        for (name, lanes, tiled) in [
-            ("scalar rows", false, false),
-            ("lane rows", true, false),
-            ("lanes, each pair once", true, true),
-        ] {
+        for (name, lanes) in [("scalar rows", false), ("lane rows", true)] {
             let mut sys = AveragedSystem::new(s.swimmers(), base, Coefficients::Paper, &y);
             sys.set_vector_rows(Some(lanes));
-            sys.set_tiled_rows(Some(tiled));
             let t = pool.install(|| {
                 sys.rhs(0.0, &y, &mut dy);
                 let start = Instant::now();

@@ -126,8 +126,7 @@ fn cell_lists_give_the_all_pairs_rates() {
 }
 
 // Each swimmer sums its partners in one order whatever thread runs it: 1, 2 or 3 threads give
-// the same bits, by lane rows (300 swimmers, above the parallel threshold) and with each pair
-// once in tiles (700, above TILED_SWIMMERS: six tiles, rounds of three tile pairs).
+// the same bits (300 and 700 swimmers, above the parallel threshold, in vector lanes).
 #[test]
 fn averaged_rows_do_not_depend_on_the_thread_count() {
     for n in [300, 700] {
@@ -402,10 +401,10 @@ fn large_averaged_guards_name_the_same_swimmers() {
     assert!(e.contains("swimmer 50") && e.contains("swimmer 300"), "{e}");
 }
 
-// The vector-lane rows, by rows and each pair once (tiled), against the scalar rows: every term
-// in play (asymmetric and symmetric swimmers, both coefficient sets, every shortcut on and off, a
-// cutoff, steric repulsion), each 3-vector within 1e-13 of the largest of its kind (≤ 700 terms
-// summed in another order). 700 swimmers: six tiles, the last one short.
+// The vector-lane rows against the scalar rows: every term in play (asymmetric and symmetric
+// swimmers, both coefficient sets, every shortcut on and off, a cutoff, steric repulsion), each
+// 3-vector within 1e-13 of the largest of its kind (≤ 700 terms summed in another order, the
+// lanes' brackets with fused multiply-adds).
 #[test]
 fn vector_lane_rows_equal_the_scalar_rows() {
     use swimlab::engine::averaged::Shortcuts;
@@ -431,7 +430,7 @@ fn vector_lane_rows_equal_the_scalar_rows() {
                     None,
                     Some(swimlab::engine::Steric::new(1e-7, 1e-3).unwrap()),
                 ] {
-                    let rates = |lanes: bool, tiled: bool| {
+                    let rates = |lanes: bool| {
                         let mut sys = AveragedSystem::with_shortcuts(
                             mixed.swimmers(),
                             base,
@@ -449,28 +448,25 @@ fn vector_lane_rows_equal_the_scalar_rows() {
                             1e-3,
                         );
                         sys.set_vector_rows(Some(lanes));
-                        sys.set_tiled_rows(Some(tiled));
                         let mut dy = vec![0.0; y.len()];
                         sys.rhs(0.0, y, &mut dy);
                         dy
                     };
-                    let b = rates(false, false);
-                    for a in [rates(true, false), rates(true, true)] {
-                        let n = a.len() / 6;
-                        for kind in [0, 1] {
-                            let block = |v: &[f64], i: usize| {
-                                let k = 6 * i + 3 * kind;
-                                Vector3::new(v[k], v[k + 1], v[k + 2])
-                            };
-                            let scale = (0..n).map(|i| block(&b, i).norm()).fold(0.0, f64::max);
-                            assert!(scale > 0.0);
-                            for i in 0..n {
-                                let d = (block(&a, i) - block(&b, i)).norm();
-                                assert!(
-                                d <= 1e-13 * scale,
-                                "{set:?} {shortcuts:?} cutoff {cutoff:?} steric {steric:?}, swimmer {i}: {d:e} of {scale:e}"
-                            );
-                            }
+                    let (a, b) = (rates(true), rates(false));
+                    let n = a.len() / 6;
+                    for kind in [0, 1] {
+                        let block = |v: &[f64], i: usize| {
+                            let k = 6 * i + 3 * kind;
+                            Vector3::new(v[k], v[k + 1], v[k + 2])
+                        };
+                        let scale = (0..n).map(|i| block(&b, i).norm()).fold(0.0, f64::max);
+                        assert!(scale > 0.0);
+                        for i in 0..n {
+                            let d = (block(&a, i) - block(&b, i)).norm();
+                            assert!(
+                            d <= 1e-13 * scale,
+                            "{set:?} {shortcuts:?} cutoff {cutoff:?} steric {steric:?}, swimmer {i}: {d:e} of {scale:e}"
+                        );
                         }
                     }
                 }

@@ -182,8 +182,6 @@ pub struct AveragedSystem {
     cells: Option<bool>,
     /// Sum all-pairs rows in vector lanes: `None` decides by size ([`LANE_SWIMMERS`]).
     lanes: Option<bool>,
-    /// In lanes, each pair once for both swimmers: `None` decides by size.
-    tiled: Option<bool>,
     /// Thermal noise: the seed and each swimmer's rigid-dumbbell diffusion.
     thermal: Option<(u64, Vec<RigidDiffusion>)>,
     /// The periodic box, if any: pairs by minimum image (the scene requires a cutoff ≤ L/2).
@@ -252,7 +250,6 @@ impl AveragedSystem {
             grid: None,
             cells: None,
             lanes: None,
-            tiled: None,
             cell_soa: Soa::default(),
             cell_phase: Vec::new(),
             thermal: None,
@@ -330,13 +327,6 @@ impl AveragedSystem {
     /// rounding of the summation order.
     pub fn set_vector_rows(&mut self, on: Option<bool>) {
         self.lanes = on;
-    }
-
-    /// With vector lanes, evaluate each pair once for both swimmers, or by rows (`None`: by size,
-    /// [`lanes::TILED_SWIMMERS`]). Either equals the scalar rows to the rounding of the
-    /// summation order.
-    pub fn set_tiled_rows(&mut self, on: Option<bool>) {
-        self.tiled = on;
     }
 
     /// Force cell lists on or off for the cutoff's pairs (`None`: by size). They equal the
@@ -529,8 +519,6 @@ impl AveragedSystem {
             && self.grid.is_none()
             && self.periodic.is_none()
             && self.lanes.unwrap_or(count >= LANE_SWIMMERS);
-        let tiled = (vector && self.tiled.unwrap_or(count >= lanes::TILED_SWIMMERS))
-            .then(|| lanes::pair_rates(self, parallel));
         let one = |s: usize, out: &mut [f64]| {
             if let Some(axis) = self.axis {
                 let v = self.row_aligned(s) * axis;
@@ -538,13 +526,10 @@ impl AveragedSystem {
                 out[3..6].fill(0.0);
                 return;
             }
-            let (mut v, t) = match &tiled {
-                Some(r) => (
-                    Vector3::new(r[0][s], r[1][s], r[2][s]),
-                    Vector3::new(r[3][s], r[4][s], r[5][s]),
-                ),
-                None if vector => lanes::row(self, s),
-                None => self.row(s),
+            let (mut v, t) = if vector {
+                lanes::row(self, s)
+            } else {
+                self.row(s)
             };
             let n = vec3(y, STATE_PER_SWIMMER * s + 3);
             let mut dn = -(t - n * n.dot(&t));
