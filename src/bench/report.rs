@@ -84,7 +84,7 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
             let t = pairs::run(n, if quick { 3 } else { 11 });
             println!(
                 "RPY product u_i = sum_j H_ij F_j, N = {n} spheres, N(N-1) interactions per product, vector unit {} (medians):\n{}",
-                crate::engine::pairs::vector_unit(),
+                crate::engine::simd::vector_unit(),
                 t.render()
             );
             t.write_csv(std::path::Path::new("out/bench/pairs.csv"))

@@ -222,11 +222,6 @@ fn lane_sum(a: &[f64; LANES]) -> f64 {
     ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]))
 }
 
-/// The widest vector unit this CPU has, for the report.
-pub fn vector_unit() -> &'static str {
-    super::simd::vector_unit()
-}
-
 vector_dispatch! {
     /// [`rows_impl`] in the widest vector unit present.
     fn rows(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) = rows_impl;
