@@ -144,8 +144,15 @@ fn min_gap_finds_the_closest_pair() {
 fn overlapping_spheres_take_the_overlap_form_in_the_fast_kernels() {
     for n in [300, 1100] {
         let mut s = lattice(n);
-        // 17 and 150 overlap partly; 40 sits inside 41 (|r| < |a40 − a41|); 90 and 91 at one point.
-        let mut moves = vec![(150, 17, 0.6e-6), (40, 41, 0.05e-6), (90, 91, 0.0)];
+        // 17 and 150 overlap partly; 40 sits inside 41 (|r| < |a40 − a41|); 90 and 91 at one point;
+        // 201 (radius 0.5 µm) is 0.1 µm clear of 200 (1 µm): within the reach the tiled kernel
+        // scans for overlaps, not overlapping.
+        let mut moves = vec![
+            (150, 17, 0.6e-6),
+            (40, 41, 0.05e-6),
+            (90, 91, 0.0),
+            (201, 200, 1.6e-6),
+        ];
         if n > 1050 {
             moves.push((1050, 3, 0.3e-6));
         }
@@ -156,6 +163,8 @@ fn overlapping_spheres_take_the_overlap_form_in_the_fast_kernels() {
         }
         s.set_radius(41, 1.0e-6);
         s.set_radius(40, 0.5e-6);
+        s.set_radius(200, 1.0e-6);
+        s.set_radius(201, 0.5e-6);
         let r = reference(Mobility::Rpy, &s);
         for (name, kernel) in KERNELS {
             for parallel in [false, true] {

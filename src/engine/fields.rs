@@ -228,7 +228,13 @@ impl Field {
                     let m = reach.min(half);
                     (
                         centre - m,
-                        centre + m + if n[d] % 2 == 0 && reach > half { 1 } else { 0 },
+                        centre
+                            + m
+                            + if n[d].is_multiple_of(2) && reach > half {
+                                1
+                            } else {
+                                0
+                            },
                     )
                 }
                 None => (

@@ -6,24 +6,29 @@
 //! Two kernels:
 //!
 //! - **Each pair once** ([`symmetric_velocities`], from [`SYMMETRIC_SPHERES`] spheres): H_ji =
-//!   H_ij, so one evaluation (one square root, one division) gives both ends' terms, the partner's
-//!   added into its accumulator in the same pass. Spheres are grouped in tiles; every tile with
-//!   itself, then every two tiles, in the rounds of a round-robin tournament ([`tile_rounds`]): a
-//!   round's tile pairs touch disjoint accumulators, so they run in parallel with rayon. 1.4–1.7×
-//!   the rows' interactions per second (README, "Suspensions and the CPU pair kernel").
+//!   H_ij, so one evaluation (one 1/r) gives both ends' terms, the partner's added into its
+//!   accumulator in the same pass. Spheres are grouped in tiles; every tile with itself, then
+//!   every two tiles, in the rounds of a round-robin tournament ([`tile_rounds`]): a round's tile
+//!   pairs touch disjoint accumulators, so they run in parallel with rayon. A tile pair runs
+//!   without overlap masks unless one of its pairs overlaps (then it is redone with them), and
+//!   in the AVX-512 build takes 1/r from the 14-bit estimate and one correction
+//!   ([`super::simd::Avx512InvSqrt`]). About 2× the rows' interactions per second (README,
+//!   "Suspensions and the CPU pair kernel").
 //! - **By rows** ([`row_velocities`]): each row i sums over all j, every pair evaluated from both
 //!   ends; rows are independent and run in parallel.
 //!
 //! Either way each sphere's terms add up in an order fixed by the sphere count alone, whatever the
-//! thread count or the vector width (multiply-adds are fused only where written, and a fused one
-//! rounds the same in every width), so results depend on neither. The j = i term and overlapping
-//! pairs are removed by a select, not a branch, and added afterwards in a scalar pass. The
-//! symmetric half-loop of [`super::mobility::Mobility::interaction_velocities`] remains the
-//! reference and serves small scenes.
+//! thread count (multiply-adds are fused only where written, and a fused one rounds the same in
+//! every width), so results do not depend on it; the rows do not depend on the vector width
+//! either, and the tiles only through the AVX-512 build's 1/r (within 2 ulp of a square root and
+//! a division). The j = i term and overlapping pairs are removed by a select, not a branch, and
+//! added afterwards in a scalar pass. The symmetric half-loop of
+//! [`super::mobility::Mobility::interaction_velocities`] remains the reference and serves small
+//! scenes.
 
 use super::mobility::Mobility;
 use super::periodic::PeriodicBox;
-use super::simd::vector_dispatch;
+use super::simd::{vector_dispatch, InvSqrt};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -259,32 +264,63 @@ struct Tiled<'a> {
 }
 
 /// The half row of sphere `i` against the spheres of `c` (all different from i): adds
-/// H_ij F_i / c1 to each column j's accumulators and returns Σ_j H_ij F_j / c1 and the count of
-/// pairs masked as overlapping (RPY: r ≤ a_i + a_j; both models: coincident spheres). Each
-/// accumulator takes its terms as two fused multiply-adds (exact in every vector width, and in
-/// software without one): the result depends on neither.
+/// H_ij F_i / c1 to each column j's accumulators and returns Σ_j H_ij F_j / c1 and a check:
+///
+/// - `MASK`: pairs closer than contact (RPY: r ≤ a_i + a_j; both models: coincident spheres)
+///   are masked out, and the check is their count;
+/// - otherwise every pair takes the far-field form, and the check is the smallest r² met (the
+///   caller redoes the tile pair masked if that could be an overlap).
+///
+/// Each accumulator takes its terms as two fused multiply-adds (exact in every vector width,
+/// and in software without one): the sums depend on neither; 1/r is `U`'s.
 #[inline(always)]
-fn half_row(t: Tiled<'_>, i: usize, c: &mut Cols<'_>) -> ([f64; 3], f64) {
+fn half_row<U: InvSqrt, const MASK: bool>(
+    t: Tiled<'_>,
+    i: usize,
+    c: &mut Cols<'_>,
+) -> ([f64; 3], f64) {
     let s = t.s;
     let (xi, yi, zi, ai, ai2) = (s.x[i], s.y[i], s.z[i], t.reach_a[i], t.a2s[i]);
     let (fxi, fyi, fzi) = (s.fx[i], s.fy[i], s.fz[i]);
-    // H_ij / c1 = cf 1 + g r rᵀ: returns (r, cf, g (r·F_j), g (r·F_i), masked).
-    #[allow(clippy::too_many_arguments)]
-    let term = |x: f64, y: f64, z: f64, a: f64, a2: f64, fx: f64, fy: f64, fz: f64| {
+    let separation = |x: f64, y: f64, z: f64| {
         let (rx, ry, rz) = (xi - x, yi - y, zi - z);
-        let r2 = rx.mul_add(rx, ry.mul_add(ry, rz * rz));
-        let inv = 1.0 / r2.sqrt();
+        ([rx, ry, rz], rx.mul_add(rx, ry.mul_add(ry, rz * rz)))
+    };
+    // Whether a pair at r² with partner reach a is counted (always, unmasked).
+    let separated = |r2: f64, a: f64| {
         let contact = ai + a;
-        let separated = r2 > contact * contact;
-        let inv_r = if separated { inv } else { 0.0 };
-        let masked = if separated { 0.0 } else { 1.0 };
+        !MASK || r2 > contact * contact
+    };
+    // H_ij / c1 = cf 1 + g r rᵀ from 1/r (0 for a masked pair): (cf, g (r·F_j), g (r·F_i)).
+    let coefficients = |r: [f64; 3], inv_r: f64, a2: f64, f: [f64; 3]| {
         let inv_r2 = inv_r * inv_r;
         let f3 = (ai2 + a2) * inv_r * inv_r2;
         let cf = inv_r + f3;
         let g = (-3.0f64).mul_add(f3, inv_r) * inv_r2;
-        let gj = g * rx.mul_add(fx, ry.mul_add(fy, rz * fz));
-        let gi = g * rx.mul_add(fxi, ry.mul_add(fyi, rz * fzi));
-        ([rx, ry, rz], cf, gj, gi, masked)
+        let gj = g * r[0].mul_add(f[0], r[1].mul_add(f[1], r[2] * f[2]));
+        let gi = g * r[0].mul_add(fxi, r[1].mul_add(fyi, r[2] * fzi));
+        (cf, gj, gi)
+    };
+    // The check's contribution of a pair at r²: masked or not, or r² itself.
+    let check = |r2: f64, counted: bool| {
+        if MASK {
+            if counted {
+                0.0
+            } else {
+                1.0
+            }
+        } else {
+            r2
+        }
+    };
+    let fold = |acc: f64, v: f64| {
+        if MASK {
+            acc + v
+        } else if v < acc {
+            v
+        } else {
+            acc
+        }
     };
     let n = c.x.len();
     let r = c.base..c.base + n;
@@ -296,7 +332,7 @@ fn half_row(t: Tiled<'_>, i: usize, c: &mut Cols<'_>) -> ([f64; 3], f64) {
     let mut ax = [0.0; LANES];
     let mut ay = [0.0; LANES];
     let mut az = [0.0; LANES];
-    let mut masked = [0.0; LANES];
+    let mut checks = [if MASK { 0.0 } else { f64::INFINITY }; LANES];
     for b in 0..blocks {
         let o = b * LANES;
         let l8 = o..o + LANES;
@@ -311,34 +347,44 @@ fn half_row(t: Tiled<'_>, i: usize, c: &mut Cols<'_>) -> ([f64; 3], f64) {
             |v: &[f64]| -> [f64; LANES] { v[o..o + LANES].try_into().unwrap_or([0.0; LANES]) };
         let (xb, yb, zb, ab, a2b) = (lanes(x), lanes(y), lanes(z), lanes(a), lanes(a2));
         let (fxb, fyb, fzb) = (lanes(fx), lanes(fy), lanes(fz));
+        let seps: [_; LANES] = std::array::from_fn(|l| separation(xb[l], yb[l], zb[l]));
+        // SAFETY: `U` is the one vector_dispatch! chose for the unit this build runs on.
+        let inv = unsafe { U::inv_sqrt(seps.map(|(_, r2)| r2)) };
         let (mut vx, mut vy, mut vz) = (*cx, *cy, *cz);
         for l in 0..LANES {
-            let (rv, cf, gj, gi, m) =
-                term(xb[l], yb[l], zb[l], ab[l], a2b[l], fxb[l], fyb[l], fzb[l]);
+            let (rv, r2) = seps[l];
+            let counted = separated(r2, ab[l]);
+            let inv_r = if counted { inv[l] } else { 0.0 };
+            let (cf, gj, gi) = coefficients(rv, inv_r, a2b[l], [fxb[l], fyb[l], fzb[l]]);
             ax[l] = gj.mul_add(rv[0], cf.mul_add(fxb[l], ax[l]));
             ay[l] = gj.mul_add(rv[1], cf.mul_add(fyb[l], ay[l]));
             az[l] = gj.mul_add(rv[2], cf.mul_add(fzb[l], az[l]));
             vx[l] = gi.mul_add(rv[0], cf.mul_add(fxi, vx[l]));
             vy[l] = gi.mul_add(rv[1], cf.mul_add(fyi, vy[l]));
             vz[l] = gi.mul_add(rv[2], cf.mul_add(fzi, vz[l]));
-            masked[l] += m;
+            checks[l] = fold(checks[l], check(r2, counted));
         }
         (*cx, *cy, *cz) = (vx, vy, vz);
     }
     for j in blocks * LANES..n {
-        let (rv, cf, gj, gi, m) = term(x[j], y[j], z[j], a[j], a2[j], fx[j], fy[j], fz[j]);
+        let (rv, r2) = separation(x[j], y[j], z[j]);
+        let counted = separated(r2, a[j]);
+        let inv_r = if counted { 1.0 / r2.sqrt() } else { 0.0 };
+        let (cf, gj, gi) = coefficients(rv, inv_r, a2[j], [fx[j], fy[j], fz[j]]);
         ax[0] = gj.mul_add(rv[0], cf.mul_add(fx[j], ax[0]));
         ay[0] = gj.mul_add(rv[1], cf.mul_add(fy[j], ay[0]));
         az[0] = gj.mul_add(rv[2], cf.mul_add(fz[j], az[0]));
         ux[j] = gi.mul_add(rv[0], cf.mul_add(fxi, ux[j]));
         uy[j] = gi.mul_add(rv[1], cf.mul_add(fyi, uy[j]));
         uz[j] = gi.mul_add(rv[2], cf.mul_add(fzi, uz[j]));
-        masked[0] += m;
+        checks[0] = fold(checks[0], check(r2, counted));
     }
-    (
-        [lane_sum(&ax), lane_sum(&ay), lane_sum(&az)],
-        lane_sum(&masked),
-    )
+    let check = if MASK {
+        lane_sum(&checks)
+    } else {
+        checks.into_iter().fold(f64::INFINITY, fold)
+    };
+    ([lane_sum(&ax), lane_sum(&ay), lane_sum(&az)], check)
 }
 
 /// The spheres of `c` that sphere `i` overlaps (the pairs [`half_row`] masked).
@@ -354,66 +400,109 @@ fn overlapping_in(t: Tiled<'_>, i: usize, c: &Cols<'_>, out: &mut Vec<usize>) {
     }
 }
 
-/// Sphere `i`'s half row against `c`, added to its accumulators `own`; the spheres of masked
-/// pairs are pushed to `masked`.
-#[inline(always)]
-fn add_half_row(
-    t: Tiled<'_>,
-    i: usize,
-    c: &mut Cols<'_>,
-    own: [&mut f64; 3],
-    masked: &mut Vec<usize>,
-) {
-    let (u, m) = half_row(t, i, c);
-    for (o, v) in own.into_iter().zip(u) {
-        *o += v;
-    }
-    if m > 0.0 {
-        masked.push(i);
-        overlapping_in(t, i, c, masked);
-    }
+/// For every pair of the tiles `rows` and `cols` (given by their accumulators), or of the tile
+/// `rows` with itself when `cols` is `None`: sphere i's half row against its partners j (those
+/// of `cols`, or those after i in `rows`), `$body` with `$i` and the partners' `Cols` as `$c`,
+/// whose value (the half row's sum) is added to row i's accumulators. A macro, not a closure:
+/// the body must be compiled in its caller's vector unit.
+macro_rules! for_half_rows {
+    ($rows:expr, $cols:expr, |$i:ident, $c:ident| $body:expr) => {{
+        let rows: &mut Cols<'_> = $rows;
+        let base = rows.base;
+        let (x, y, z) = (&mut *rows.x, &mut *rows.y, &mut *rows.z);
+        match $cols {
+            Some($c) => {
+                for r in 0..x.len() {
+                    let $i = base + r;
+                    let u: [f64; 3] = $body;
+                    (x[r], y[r], z[r]) = (x[r] + u[0], y[r] + u[1], z[r] + u[2]);
+                }
+            }
+            None => {
+                for r in 0..x.len() {
+                    let (xr, xc) = x.split_at_mut(r + 1);
+                    let (yr, yc) = y.split_at_mut(r + 1);
+                    let (zr, zc) = z.split_at_mut(r + 1);
+                    let $c = &mut Cols {
+                        base: base + r + 1,
+                        x: xc,
+                        y: yc,
+                        z: zc,
+                    };
+                    let $i = base + r;
+                    let u: [f64; 3] = $body;
+                    (xr[r], yr[r], zr[r]) = (xr[r] + u[0], yr[r] + u[1], zr[r] + u[2]);
+                }
+            }
+        }
+    }};
 }
 
-/// Every pair of the tiles `rows` and `cols` (both given by their accumulators), or of the tile
-/// `rows` with itself when `cols` is `None`; returns the spheres of masked pairs.
+/// Every pair of the tiles `rows` and `cols` (or of `rows` with itself when `cols` is `None`),
+/// added to both ends' accumulators; returns the spheres of pairs closer than contact, whose
+/// terms the caller adds in the overlapping form.
+///
+/// First all pairs in the far-field form, with no masks (6 fewer vector operations a pair),
+/// each row tracking the smallest r² it meets. A row that met a partner within its reach plus
+/// the tile's largest is scanned for overlaps; if it has one, the accumulators are put back and
+/// the tile pair is redone with the masks. Either way the sums are the same function of the
+/// positions, whatever the thread count.
 #[inline(always)]
-fn tile_pairs(t: Tiled<'_>, rows: Cols<'_>, cols: Option<Cols<'_>>) -> Vec<usize> {
-    let mut masked = Vec::new();
-    let Cols { base, x, y, z } = rows;
-    match cols {
-        Some(mut c) => {
-            for r in 0..x.len() {
-                add_half_row(
-                    t,
-                    base + r,
-                    &mut c,
-                    [&mut x[r], &mut y[r], &mut z[r]],
-                    &mut masked,
-                );
-            }
+fn tile_pairs<'a, U: InvSqrt>(
+    t: Tiled<'_>,
+    mut rows: Cols<'a>,
+    mut cols: Option<Cols<'a>>,
+) -> Vec<usize> {
+    let mut saved: Vec<f64> = Vec::new();
+    for c in std::iter::once(&rows).chain(cols.as_ref()) {
+        saved.extend_from_slice(c.x);
+        saved.extend_from_slice(c.y);
+        saved.extend_from_slice(c.z);
+    }
+    let reach = |c: &Cols<'_>| {
+        t.reach_a[c.base..c.base + c.x.len()]
+            .iter()
+            .fold(0.0f64, |m, &a| m.max(a))
+    };
+    let reach_cols = cols.as_ref().map_or_else(|| reach(&rows), reach);
+    let mut overlap = false;
+    for_half_rows!(&mut rows, cols.as_mut(), |i, c| {
+        let (u, r2_min) = half_row::<U, false>(t, i, c);
+        let contact = t.reach_a[i] + reach_cols;
+        // A partner within reach of the tile's largest: look for an overlap (the far-field form
+        // is right for every other pair); coincident spheres (r² = 0) never are clear, nor a NaN.
+        let clear = r2_min > contact * contact;
+        if !overlap && !clear {
+            let mut found = Vec::new();
+            overlapping_in(t, i, c, &mut found);
+            overlap = !found.is_empty();
         }
-        None => {
-            for r in 0..x.len() {
-                let (xr, xc) = x.split_at_mut(r + 1);
-                let (yr, yc) = y.split_at_mut(r + 1);
-                let (zr, zc) = z.split_at_mut(r + 1);
-                let (i, own) = (base + r, [&mut xr[r], &mut yr[r], &mut zr[r]]);
-                let mut c = Cols {
-                    base: i + 1,
-                    x: xc,
-                    y: yc,
-                    z: zc,
-                };
-                add_half_row(t, i, &mut c, own, &mut masked);
-            }
+        u
+    });
+    if !overlap {
+        return Vec::new();
+    }
+    let mut from = saved.into_iter();
+    for c in std::iter::once(&mut rows).chain(cols.as_mut()) {
+        for v in [&mut *c.x, &mut *c.y, &mut *c.z] {
+            v.iter_mut().zip(&mut from).for_each(|(v, s)| *v = s);
         }
     }
+    let mut masked = Vec::new();
+    for_half_rows!(&mut rows, cols.as_mut(), |i, c| {
+        let (u, m) = half_row::<U, true>(t, i, c);
+        if m > 0.0 {
+            masked.push(i);
+            overlapping_in(t, i, c, &mut masked);
+        }
+        u
+    });
     masked
 }
 
 vector_dispatch! {
     /// [`tile_pairs`] in the widest vector unit present.
-    fn tile_pairs_dispatch(t: Tiled<'_>, r: Cols<'_>, c: Option<Cols<'_>>) -> Vec<usize> = tile_pairs;
+    fn tile_pairs_dispatch(t: Tiled<'_>, r: Cols<'_>, c: Option<Cols<'_>>) -> Vec<usize> = tile_pairs::<InvSqrt>;
 }
 
 /// The accumulators split into tiles of `tile` spheres.

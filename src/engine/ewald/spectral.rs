@@ -183,7 +183,8 @@ impl SpectralEwald {
         let cell = h[0] * h[1] * h[2];
         let volume = periodic.volume();
         // The Nyquist planes of even grids are left out (their waves have no ± partner).
-        let mode = |i: usize, n: usize| (!(n % 2 == 0 && i == n / 2)).then(|| signed_mode(i, n));
+        let mode =
+            |i: usize, n: usize| (!(n.is_multiple_of(2) && i == n / 2)).then(|| signed_mode(i, n));
         let mut kernel = vec![0.0; points];
         kernel
             .par_chunks_mut(m[2] * m[1])

@@ -201,7 +201,7 @@ impl Stepper for Rosenbrock {
         if self.block.len() != bs {
             self.block = DVector::zeros(bs);
         }
-        if bs > 0 && n % bs != 0 {
+        if bs > 0 && !n.is_multiple_of(bs) {
             return Err(StepFailure {
                 time: t,
                 problem: Problem {
