@@ -50,16 +50,23 @@ struct Row {
     cos: f64,
     k: [f64; 4],
     ell: f64,
-    skip_zero: bool,
+    /// |sin(φσ − φρ)| a pair must exceed to count: [`SIN_ZERO`] when zero-phase pairs are
+    /// skipped, −1 (every pair) when not.
+    sin_floor: f64,
     cutoff2: f64,
 }
 
+/// Accumulators of a row: Σ vn (the coefficient of the row's own orientation, applied once at
+/// the end), Σ D̂ jd (velocity) and Σ D̂ td (torque-like).
+type Acc = [f64; 7];
+
 /// A partner's (position, orientation, sin φ, cos φ) contributions added to the row's
-/// accumulators; `own` masks the row's swimmer. Skipped pairs (itself, a zero phase difference,
-/// beyond the cutoff) get a zero sine by a select, not a branch, per lane.
+/// accumulators. Skipped pairs (a zero phase difference, beyond the cutoff, and with `OWN` the
+/// row's own swimmer where `own`) get a zero sine by a select, not a branch, per lane; only the
+/// block holding the row's own swimmer pays for its mask.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn lane_term(
+fn lane_term<const OWN: bool>(
     p: &Row,
     x: f64,
     y: f64,
@@ -70,24 +77,26 @@ fn lane_term(
     sn: f64,
     cs: f64,
     own: bool,
-    acc: [f64; 6],
-) -> [f64; 6] {
+    acc: Acc,
+) -> Acc {
     let (dx, dy, dz) = (p.at[0] - x, p.at[1] - y, p.at[2] - z);
     let d2 = dx.mul_add(dx, dy.mul_add(dy, dz * dz));
     let raw = p.sin * cs - p.cos * sn;
-    let keep = !own & ((raw.abs() > SIN_ZERO) | !p.skip_zero) & (d2 <= p.cutoff2);
+    let keep = (raw.abs() > p.sin_floor) & (d2 <= p.cutoff2) & !(OWN && own);
     let sin = if keep { raw } else { 0.0 };
+    // A skipped pair may sit at distance 0 (the own swimmer always does): a 1 there keeps its
+    // zero terms finite.
     let d2 = if keep { d2 } else { 1.0 };
     let inv = 1.0 / d2.sqrt();
     let h = [dx * inv, dy * inv, dz * inv];
     let dot = |u: [f64; 3], v: [f64; 3]| u[0].mul_add(v[0], u[1].mul_add(v[1], u[2] * v[2]));
     let (a, b) = (p.n, [bx, by, bz]);
     let (ss, rr, q) = (dot(h, a), dot(h, b), dot(a, b));
-    side(p.k, sin, p.ell * inv, ss, rr, q, a, h, acc)
+    side(p.k, sin, p.ell * inv, ss, rr, q, h, acc)
 }
 
 #[inline(always)]
-fn row_impl(sys: &AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) {
+fn row_impl<'a>(sys: &'a AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) {
     let c = &sys.coef[s];
     let soa = &sys.soa;
     let n = sys.coef.len();
@@ -98,43 +107,60 @@ fn row_impl(sys: &AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) {
         cos: sys.cos_phi[s],
         k: prefactors(sys, c),
         ell: c.ell,
-        skip_zero: sys.skip_zero_phase,
+        sin_floor: if sys.skip_zero_phase { SIN_ZERO } else { -1.0 },
         cutoff2: sys.cutoff2,
     };
-    // A closure around a function: a large closure is not always inlined, and the block must be.
-    let term = |x, y, z, bx, by, bz, sn, cs, own, acc| {
-        lane_term(&p, x, y, z, bx, by, bz, sn, cs, own, acc)
-    };
-    let mut acc = [[0.0; LANES]; 6];
+    let mut acc = [[0.0; LANES]; 7];
     let blocks = n / LANES;
-    let block = |v: &[f64], o: usize| -> [f64; LANES] {
-        v[o..o + LANES].try_into().unwrap_or([0.0; LANES])
-    };
-    for b in 0..blocks {
-        let o = b * LANES;
-        let (x, y, z) = (block(&soa.x, o), block(&soa.y, o), block(&soa.z, o));
-        let (bx, by, bz) = (block(&soa.nx, o), block(&soa.ny, o), block(&soa.nz, o));
-        let (sn, cs) = (block(&sys.sin_phi, o), block(&sys.cos_phi, o));
-        for l in 0..LANES {
-            let t = term(
-                x[l],
-                y[l],
-                z[l],
-                bx[l],
-                by[l],
-                bz[l],
-                sn[l],
-                cs[l],
-                o + l == s,
-                std::array::from_fn(|m| acc[m][l]),
-            );
-            for m in 0..6 {
-                acc[m][l] = t[m];
+    // Whole blocks of each array (exact chunks: no bounds checks in the loop).
+    let chunks = |v: &'a [f64]| v[..blocks * LANES].chunks_exact(LANES);
+    let partners = chunks(&soa.x)
+        .zip(chunks(&soa.y))
+        .zip(chunks(&soa.z))
+        .zip(chunks(&soa.nx))
+        .zip(chunks(&soa.ny))
+        .zip(chunks(&soa.nz))
+        .zip(chunks(&sys.sin_phi))
+        .zip(chunks(&sys.cos_phi));
+    // Every lane of a block through `lane_term::<OWN>` (a macro: the block must be compiled
+    // inline, in the caller's vector unit, and a large closure is not always inlined).
+    macro_rules! block_of {
+        ($own:literal, $o:expr, $x:expr, $y:expr, $z:expr, $bx:expr, $by:expr, $bz:expr, $sn:expr, $cs:expr) => {{
+            let o = $o;
+            let arr = |v: &[f64]| -> [f64; LANES] { v.try_into().unwrap_or([0.0; LANES]) };
+            let (x, y, z) = (arr($x), arr($y), arr($z));
+            let (bx, by, bz, sn, cs) = (arr($bx), arr($by), arr($bz), arr($sn), arr($cs));
+            for l in 0..LANES {
+                let t = lane_term::<$own>(
+                    &p,
+                    x[l],
+                    y[l],
+                    z[l],
+                    bx[l],
+                    by[l],
+                    bz[l],
+                    sn[l],
+                    cs[l],
+                    o + l == s,
+                    std::array::from_fn(|m| acc[m][l]),
+                );
+                for m in 0..7 {
+                    acc[m][l] = t[m];
+                }
             }
+        }};
+    }
+    for (b, (((((((x, y), z), bx), by), bz), sn), cs)) in partners.enumerate() {
+        let o = b * LANES;
+        if (o..o + LANES).contains(&s) {
+            block_of!(true, o, x, y, z, bx, by, bz, sn, cs);
+        } else {
+            block_of!(false, o, x, y, z, bx, by, bz, sn, cs);
         }
     }
     for r in blocks * LANES..n {
-        let t = term(
+        let t = lane_term::<true>(
+            &p,
             soa.x[r],
             soa.y[r],
             soa.z[r],
@@ -146,12 +172,20 @@ fn row_impl(sys: &AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) {
             r == s,
             std::array::from_fn(|m| acc[m][0]),
         );
-        for m in 0..6 {
+        for m in 0..7 {
             acc[m][0] = t[m];
         }
     }
-    let [v0, v1, v2, t0, t1, t2] = acc.map(|a| lane_sum(&a));
-    (Vector3::new(v0, v1, v2), Vector3::new(t0, t1, t2))
+    let [vn, v0, v1, v2, t0, t1, t2] = acc.map(|a| lane_sum(&a));
+    let n = p.n;
+    (
+        Vector3::new(
+            n[0].mul_add(vn, v0),
+            n[1].mul_add(vn, v1),
+            n[2].mul_add(vn, v2),
+        ),
+        Vector3::new(t0, t1, t2),
+    )
 }
 
 vector_dispatch! {
@@ -161,54 +195,44 @@ vector_dispatch! {
 
 /// The rates a swimmer gets from one partner: its prefactors (J, L, I, K), the phase sine,
 /// ξ = ℓ/D, its ss = D̂·N_own and rr = D̂·N_partner with D̂ pointing from the partner to it,
-/// q = N_own·N_partner, its orientation and D̂: its accumulators of (dR_H/dt, T) with the pair's
-/// terms added (as fused multiply-adds).
+/// q = N_own·N_partner and D̂: its accumulators with the pair's terms added (as fused
+/// multiply-adds). The brackets are polynomials in u = ss², v = rr², w = q ss rr, uv, u + v and
+/// q², shared among them.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn side(
-    k: [f64; 4],
-    sin: f64,
-    xi: f64,
-    ss: f64,
-    rr: f64,
-    q: f64,
-    n: [f64; 3],
-    h: [f64; 3],
-    acc: [f64; 6],
-) -> [f64; 6] {
+fn side(k: [f64; 4], sin: f64, xi: f64, ss: f64, rr: f64, q: f64, h: [f64; 3], acc: Acc) -> Acc {
     let [kj, kl, ki, kk] = k;
-    let sx3 = sin * xi * xi * xi;
+    let sx3 = sin * xi * (xi * xi);
     let sx4 = sx3 * xi;
-    let (ss2, rr2, qsr) = (ss * ss, rr * rr, q * ss * rr);
+    let (u, v, q2, qr) = (ss * ss, rr * rr, q * q, q * rr);
+    let (w, uv, sum) = (qr * ss, u * v, u + v);
     // 1 + 2 q² − 5 ss² − 5 rr² − 20 q ss rr + 35 ss² rr²
-    let jk = (35.0 * ss2).mul_add(
-        rr2,
-        (-20.0f64).mul_add(qsr, (-5.0f64).mul_add(ss2 + rr2, (2.0 * q).mul_add(q, 1.0))),
+    let jk = 35.0f64.mul_add(
+        uv,
+        (-20.0f64).mul_add(w, (-5.0f64).mul_add(sum, 2.0f64.mul_add(q2, 1.0))),
     );
     // 1 − 3 rr² − 3 ss² − 6 q ss rr + 15 ss² rr²
-    let i_br = (15.0 * ss2).mul_add(
-        rr2,
-        (-6.0f64).mul_add(qsr, (-3.0f64).mul_add(ss2 + rr2, 1.0)),
-    );
-    let j = kj * sx4;
-    // 2 ss + 4 q rr − 10 ss rr²
-    let jn = j * (-10.0 * ss).mul_add(rr2, (4.0 * q).mul_add(rr, 2.0 * ss));
-    let jd = j * jk;
+    let i_br = 15.0f64.mul_add(uv, (-6.0f64).mul_add(w, (-3.0f64).mul_add(sum, 1.0)));
+    // 2 ss + 4 q rr − 10 ss rr² = ss (2 − 10 rr²) + 4 q rr
+    let jn_br = ss.mul_add((-10.0f64).mul_add(v, 2.0), 4.0 * qr);
     // 3 ss + 6 rr q + 6 ss q² − 7 ss³ − 21 ss rr² − 42 q ss² rr + 63 ss³ rr²
-    let l_ss = (63.0 * ss2).mul_add(
-        rr2,
-        (-21.0f64).mul_add(rr2, (-7.0f64).mul_add(ss2, (6.0 * q).mul_add(q, 3.0))),
+    //   = ss (3 + 6 q² − 7 ss² − 21 rr² + 63 ss² rr²) + q rr (6 − 42 ss²)
+    let l_ss = 63.0f64.mul_add(
+        uv,
+        (-21.0f64).mul_add(v, (-7.0f64).mul_add(u, 6.0f64.mul_add(q2, 3.0))),
     );
-    let l_br = ss.mul_add(l_ss, rr * q * (-42.0f64).mul_add(ss2, 6.0));
-    let l = kl * sx4 * xi * l_br;
-    let vn = (ki * sx3).mul_add(i_br, jn);
-    let td = (kk * sx4).mul_add(jk, l);
+    let l_br = ss.mul_add(l_ss, qr * (-42.0f64).mul_add(u, 6.0));
+    let j = kj * sx4;
+    let jd = j * jk;
+    let vn = (ki * sx3).mul_add(i_br, j * jn_br);
+    let td = (kk * sx4).mul_add(jk, kl * sx4 * xi * l_br);
     [
-        n[0].mul_add(vn, h[0].mul_add(jd, acc[0])),
-        n[1].mul_add(vn, h[1].mul_add(jd, acc[1])),
-        n[2].mul_add(vn, h[2].mul_add(jd, acc[2])),
-        h[0].mul_add(td, acc[3]),
-        h[1].mul_add(td, acc[4]),
-        h[2].mul_add(td, acc[5]),
+        acc[0] + vn,
+        h[0].mul_add(jd, acc[1]),
+        h[1].mul_add(jd, acc[2]),
+        h[2].mul_add(jd, acc[3]),
+        h[0].mul_add(td, acc[4]),
+        h[1].mul_add(td, acc[5]),
+        h[2].mul_add(td, acc[6]),
     ]
 }
