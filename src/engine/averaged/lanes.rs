@@ -61,12 +61,13 @@ struct Row {
 type Acc = [f64; 7];
 
 /// A partner's (position, orientation, sin φ, cos φ) contributions added to the row's
-/// accumulators. Skipped pairs (a zero phase difference, beyond the cutoff, and with `OWN` the
-/// row's own swimmer where `own`) get a zero sine by a select, not a branch, per lane; only the
-/// block holding the row's own swimmer pays for its mask.
+/// accumulators. Skipped pairs (a zero phase difference, with `CUT` beyond the cutoff, and with
+/// `OWN` the row's own swimmer where `own`) get a zero sine by a select, not a branch, per lane;
+/// only the block holding the row's own swimmer pays for its mask, and only a scene with a cutoff
+/// for the cutoff's.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn lane_term<const OWN: bool>(
+fn lane_term<const OWN: bool, const CUT: bool>(
     p: &Row,
     x: f64,
     y: f64,
@@ -82,7 +83,7 @@ fn lane_term<const OWN: bool>(
     let (dx, dy, dz) = (p.at[0] - x, p.at[1] - y, p.at[2] - z);
     let d2 = dx.mul_add(dx, dy.mul_add(dy, dz * dz));
     let raw = p.sin * cs - p.cos * sn;
-    let keep = (raw.abs() > p.sin_floor) & (d2 <= p.cutoff2) & !(OWN && own);
+    let keep = (raw.abs() > p.sin_floor) & (!CUT || d2 <= p.cutoff2) & !(OWN && own);
     let sin = if keep { raw } else { 0.0 };
     // A skipped pair may sit at distance 0 (the own swimmer always does): a 1 there keeps its
     // zero terms finite.
@@ -95,8 +96,21 @@ fn lane_term<const OWN: bool>(
     side(p.k, sin, p.ell * inv, ss, rr, q, h, acc)
 }
 
+/// The row of swimmer `s`, with the cutoff's mask only where there is one.
 #[inline(always)]
-fn row_impl<'a>(sys: &'a AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) {
+fn row_impl(sys: &AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) {
+    if sys.cutoff2.is_finite() {
+        row_with::<true>(sys, s)
+    } else {
+        row_with::<false>(sys, s)
+    }
+}
+
+#[inline(always)]
+fn row_with<'a, const CUT: bool>(
+    sys: &'a AveragedSystem,
+    s: usize,
+) -> (Vector3<f64>, Vector3<f64>) {
     let c = &sys.coef[s];
     let soa = &sys.soa;
     let n = sys.coef.len();
@@ -122,7 +136,7 @@ fn row_impl<'a>(sys: &'a AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64
         .zip(chunks(&soa.nz))
         .zip(chunks(&sys.sin_phi))
         .zip(chunks(&sys.cos_phi));
-    // Every lane of a block through `lane_term::<OWN>` (a macro: the block must be compiled
+    // Every lane of a block through `lane_term::<OWN, CUT>` (a macro: the block must be compiled
     // inline, in the caller's vector unit, and a large closure is not always inlined).
     macro_rules! block_of {
         ($own:literal, $o:expr, $x:expr, $y:expr, $z:expr, $bx:expr, $by:expr, $bz:expr, $sn:expr, $cs:expr) => {{
@@ -131,7 +145,7 @@ fn row_impl<'a>(sys: &'a AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64
             let (x, y, z) = (arr($x), arr($y), arr($z));
             let (bx, by, bz, sn, cs) = (arr($bx), arr($by), arr($bz), arr($sn), arr($cs));
             for l in 0..LANES {
-                let t = lane_term::<$own>(
+                let t = lane_term::<$own, CUT>(
                     &p,
                     x[l],
                     y[l],
@@ -159,7 +173,7 @@ fn row_impl<'a>(sys: &'a AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64
         }
     }
     for r in blocks * LANES..n {
-        let t = lane_term::<true>(
+        let t = lane_term::<true, CUT>(
             &p,
             soa.x[r],
             soa.y[r],
@@ -225,7 +239,7 @@ fn side(k: [f64; 4], sin: f64, xi: f64, ss: f64, rr: f64, q: f64, h: [f64; 3], a
     let j = kj * sx4;
     let jd = j * jk;
     let vn = (ki * sx3).mul_add(i_br, j * jn_br);
-    let td = (kk * sx4).mul_add(jk, kl * sx4 * xi * l_br);
+    let td = sx4 * kk.mul_add(jk, kl * xi * l_br);
     [
         acc[0] + vn,
         h[0].mul_add(jd, acc[1]),
