@@ -1,14 +1,15 @@
 //! The fast pair kernel ([`crate::engine::pairs`]): RPY pair interactions per second at
-//! N = 4,096 spheres, serial and on 1 … all cores, against the ~1e9 per core bound (≈36 flops and
-//! one reciprocal square root per H_ij·F_j); and the row kernel ([`row_velocities`]) serially in
-//! the same run, the comparison of the each-pair-once form against the rows.
+//! N = 4,096 spheres, serial and on 1 … all cores, against the ~1e9 per core bound of evaluating
+//! each pair from both ends (≈36 flops and one reciprocal square root per H_ij·F_j; evaluating it
+//! once for both exceeds it); and the row kernel ([`row_velocities`]) serially in the same run, the
+//! comparison of the each-pair-once form against the rows.
 
 use super::table::Table;
 use crate::engine::mobility::Mobility;
 use crate::engine::pairs::{interaction_velocities, row_velocities, SoaSpheres};
 use std::time::Instant;
 
-/// Interactions per second per core that the arithmetic allows (issue 7's bound).
+/// Interactions per second per core that the arithmetic of a pair evaluated from both ends allows.
 pub const BOUND_PER_CORE: f64 = 1e9;
 
 /// N spheres on a jittered cubic lattice 3 µm apart, radii 0.5-1 µm (as in benches/kernels.rs).
