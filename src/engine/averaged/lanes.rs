@@ -67,7 +67,7 @@ type Acc = [f64; 7];
 /// for the cutoff's.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn lane_term<const OWN: bool, const CUT: bool>(
+fn lane_term<const OWN: bool, const CUT: bool, const IK: bool>(
     p: &Row,
     x: f64,
     y: f64,
@@ -93,23 +93,29 @@ fn lane_term<const OWN: bool, const CUT: bool>(
     let dot = |u: [f64; 3], v: [f64; 3]| u[0].mul_add(v[0], u[1].mul_add(v[1], u[2] * v[2]));
     let (a, b) = (p.n, [bx, by, bz]);
     let (ss, rr, q) = (dot(h, a), dot(h, b), dot(a, b));
-    side(p.k, sin, p.ell * inv, ss, rr, q, h, acc)
+    side::<IK>(p.k, sin, p.ell * inv, ss, rr, q, h, acc)
 }
 
-/// The row of swimmer `s`, with the cutoff's mask only where there is one.
+/// The row of swimmer `s`, with the cutoff's mask only where there is one, and the I and K terms
+/// only where their prefactors are not zero (a symmetric swimmer's are: it gets the J and L terms
+/// alone, as in the scalar row).
 #[inline(always)]
 fn row_impl(sys: &AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) {
-    if sys.cutoff2.is_finite() {
-        row_with::<true>(sys, s)
-    } else {
-        row_with::<false>(sys, s)
+    let k = prefactors(sys, &sys.coef[s]);
+    let ik = k[2] != 0.0 || k[3] != 0.0;
+    match (sys.cutoff2.is_finite(), ik) {
+        (true, true) => row_with::<true, true>(sys, s, k),
+        (true, false) => row_with::<true, false>(sys, s, k),
+        (false, true) => row_with::<false, true>(sys, s, k),
+        (false, false) => row_with::<false, false>(sys, s, k),
     }
 }
 
 #[inline(always)]
-fn row_with<'a, const CUT: bool>(
+fn row_with<'a, const CUT: bool, const IK: bool>(
     sys: &'a AveragedSystem,
     s: usize,
+    k: [f64; 4],
 ) -> (Vector3<f64>, Vector3<f64>) {
     let c = &sys.coef[s];
     let soa = &sys.soa;
@@ -119,7 +125,7 @@ fn row_with<'a, const CUT: bool>(
         n: [soa.nx[s], soa.ny[s], soa.nz[s]],
         sin: sys.sin_phi[s],
         cos: sys.cos_phi[s],
-        k: prefactors(sys, c),
+        k,
         ell: c.ell,
         sin_floor: if sys.skip_zero_phase { SIN_ZERO } else { -1.0 },
         cutoff2: sys.cutoff2,
@@ -136,7 +142,7 @@ fn row_with<'a, const CUT: bool>(
         .zip(chunks(&soa.nz))
         .zip(chunks(&sys.sin_phi))
         .zip(chunks(&sys.cos_phi));
-    // Every lane of a block through `lane_term::<OWN, CUT>` (a macro: the block must be compiled
+    // Every lane of a block through `lane_term::<OWN, CUT, IK>` (a macro: the block must be compiled
     // inline, in the caller's vector unit, and a large closure is not always inlined).
     macro_rules! block_of {
         ($own:literal, $o:expr, $x:expr, $y:expr, $z:expr, $bx:expr, $by:expr, $bz:expr, $sn:expr, $cs:expr) => {{
@@ -145,7 +151,7 @@ fn row_with<'a, const CUT: bool>(
             let (x, y, z) = (arr($x), arr($y), arr($z));
             let (bx, by, bz, sn, cs) = (arr($bx), arr($by), arr($bz), arr($sn), arr($cs));
             for l in 0..LANES {
-                let t = lane_term::<$own, CUT>(
+                let t = lane_term::<$own, CUT, IK>(
                     &p,
                     x[l],
                     y[l],
@@ -173,7 +179,7 @@ fn row_with<'a, const CUT: bool>(
         }
     }
     for r in blocks * LANES..n {
-        let t = lane_term::<true, CUT>(
+        let t = lane_term::<true, CUT, IK>(
             &p,
             soa.x[r],
             soa.y[r],
@@ -214,7 +220,16 @@ vector_dispatch! {
 /// q², shared among them.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn side(k: [f64; 4], sin: f64, xi: f64, ss: f64, rr: f64, q: f64, h: [f64; 3], acc: Acc) -> Acc {
+fn side<const IK: bool>(
+    k: [f64; 4],
+    sin: f64,
+    xi: f64,
+    ss: f64,
+    rr: f64,
+    q: f64,
+    h: [f64; 3],
+    acc: Acc,
+) -> Acc {
     let [kj, kl, ki, kk] = k;
     let sx3 = sin * xi * (xi * xi);
     let sx4 = sx3 * xi;
@@ -238,8 +253,14 @@ fn side(k: [f64; 4], sin: f64, xi: f64, ss: f64, rr: f64, q: f64, h: [f64; 3], a
     let l_br = ss.mul_add(l_ss, qr * (-42.0f64).mul_add(u, 6.0));
     let j = kj * sx4;
     let jd = j * jk;
-    let vn = (ki * sx3).mul_add(i_br, j * jn_br);
-    let td = sx4 * kk.mul_add(jk, kl * xi * l_br);
+    let (vn, td) = if IK {
+        (
+            (ki * sx3).mul_add(i_br, j * jn_br),
+            sx4 * kk.mul_add(jk, kl * xi * l_br),
+        )
+    } else {
+        (j * jn_br, sx4 * (kl * xi * l_br))
+    };
     [
         acc[0] + vn,
         h[0].mul_add(jd, acc[1]),
