@@ -22,7 +22,7 @@ fn lane_sum(a: &[f64; LANES]) -> f64 {
 }
 
 /// The prefactors of a row's J, L, I and K terms (I and K zero where the symmetric-swimmer
-/// shortcut drops them).
+/// shortcut drops them), each with its power of ℓ (ξ = ℓ/D): the lanes take powers of 1/D.
 fn prefactors(sys: &AveragedSystem, c: &Coef) -> [f64; 4] {
     let with_i = if c.a_r != 0.0 || !sys.skip_symmetric {
         1.0
@@ -34,11 +34,12 @@ fn prefactors(sys: &AveragedSystem, c: &Coef) -> [f64; 4] {
     } else {
         0.0
     };
+    let (l3, l4) = (c.ell.powi(3), c.ell.powi(4));
     [
-        c.c_j * c.v0 * (9.0 / 64.0),
-        c.w0 * (15.0 / 64.0) * c.big_l,
-        with_i * c.a_r * c.v0 * (9.0 / 64.0) * c.big_l,
-        with_k * c.a_n * c.w0 * (9.0 / 32.0) * c.big_l,
+        c.c_j * c.v0 * (9.0 / 64.0) * l4,
+        c.w0 * (15.0 / 64.0) * c.big_l * l4 * c.ell,
+        with_i * c.a_r * c.v0 * (9.0 / 64.0) * c.big_l * l3,
+        with_k * c.a_n * c.w0 * (9.0 / 32.0) * c.big_l * l4,
     ]
 }
 
@@ -49,7 +50,6 @@ struct Row {
     sin: f64,
     cos: f64,
     k: [f64; 4],
-    ell: f64,
     /// |sin(φσ − φρ)| a pair must exceed to count: [`SIN_ZERO`] when zero-phase pairs are
     /// skipped, −1 (every pair) when not.
     sin_floor: f64,
@@ -93,7 +93,7 @@ fn lane_term<const OWN: bool, const CUT: bool, const IK: bool>(
     let dot = |u: [f64; 3], v: [f64; 3]| u[0].mul_add(v[0], u[1].mul_add(v[1], u[2] * v[2]));
     let (a, b) = (p.n, [bx, by, bz]);
     let (ss, rr, q) = (dot(h, a), dot(h, b), dot(a, b));
-    side::<IK>(p.k, sin, p.ell * inv, ss, rr, q, h, acc)
+    side::<IK>(p.k, sin, inv, ss, rr, q, h, acc)
 }
 
 /// The row of swimmer `s`, with the cutoff's mask only where there is one, and the I and K terms
@@ -117,7 +117,6 @@ fn row_with<'a, const CUT: bool, const IK: bool>(
     s: usize,
     k: [f64; 4],
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let c = &sys.coef[s];
     let soa = &sys.soa;
     let n = sys.coef.len();
     let p = Row {
@@ -126,7 +125,6 @@ fn row_with<'a, const CUT: bool, const IK: bool>(
         sin: sys.sin_phi[s],
         cos: sys.cos_phi[s],
         k,
-        ell: c.ell,
         sin_floor: if sys.skip_zero_phase { SIN_ZERO } else { -1.0 },
         cutoff2: sys.cutoff2,
     };
@@ -213,8 +211,8 @@ vector_dispatch! {
     pub(super) fn row(sys: &AveragedSystem, s: usize) -> (Vector3<f64>, Vector3<f64>) = row_impl;
 }
 
-/// The rates a swimmer gets from one partner: its prefactors (J, L, I, K), the phase sine,
-/// ξ = ℓ/D, its ss = D̂·N_own and rr = D̂·N_partner with D̂ pointing from the partner to it,
+/// The rates a swimmer gets from one partner: its prefactors (J, L, I, K, with their powers of ℓ),
+/// the phase sine, ξ = 1/D, its ss = D̂·N_own and rr = D̂·N_partner with D̂ pointing from the partner to it,
 /// q = N_own·N_partner and D̂: its accumulators with the pair's terms added (as fused
 /// multiply-adds). The brackets are polynomials in u = ss², v = rr², w = q ss rr, uv, u + v and
 /// q², shared among them.
@@ -231,8 +229,14 @@ fn side<const IK: bool>(
     acc: Acc,
 ) -> Acc {
     let [kj, kl, ki, kk] = k;
-    let sx3 = sin * xi * (xi * xi);
-    let sx4 = sx3 * xi;
+    // sin ξ³ and sin ξ⁴ (ξ here 1/D: ℓ's powers are in the prefactors); the former only for I.
+    let x2 = xi * xi;
+    let (sx3, sx4) = if IK {
+        let sx3 = sin * xi * x2;
+        (sx3, sx3 * xi)
+    } else {
+        (0.0, sin * (x2 * x2))
+    };
     let (u, v, q2, qr) = (ss * ss, rr * rr, q * q, q * rr);
     let (w, uv, sum) = (qr * ss, u * v, u + v);
     // 1 + 2 q² − 5 ss² − 5 rr² − 20 q ss rr + 35 ss² rr²
