@@ -5,40 +5,24 @@
 //! alternating rounds on one thread, a lane-row right-hand side against one product of the sphere
 //! kernel on 4,096 spheres (`swimlab bench pairs`'s lattice): the median ratio of an averaged
 //! swimmer pair to a sphere interaction, which the machine's load moves far less than either.
-use nalgebra::Vector3;
 use std::time::Instant;
 use swimlab::bench::pairs::lattice;
 use swimlab::engine::averaged::AveragedSystem;
-use swimlab::engine::build::lattice_scene;
+use swimlab::engine::build::lattice_scene_of;
 use swimlab::engine::integrators::OdeSystem;
 use swimlab::engine::pairs::interaction_velocities;
-use swimlab::engine::{Coefficients, Dumbbell, Mobility, Model, Scene};
+use swimlab::engine::{Coefficients, Dumbbell, Mobility, Model};
 
 fn main() {
     let n: usize = std::env::args()
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(4096);
-    let s = if std::env::args().nth(2).as_deref() == Some("asymmetric") {
-        // build::lattice_scene's lattice, of a2 = a1/2 swimmers.
-        let mut s = Scene::new();
-        s.set_model(Model::Averaged);
-        let d = Dumbbell::default();
-        let d = Dumbbell {
-            a2: d.a1 / 2.0,
-            ..d
-        };
-        let side = (n as f64).cbrt().ceil() as usize;
-        for i in 0..n {
-            let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
-            let c = Vector3::new(x as f64, y as f64, z as f64) * (3.0 * d.ell);
-            let phase = (i as f64 * 0.7) % (2.0 * std::f64::consts::PI);
-            s.add(Dumbbell { phase, ..d }, c, Vector3::x()).unwrap();
-        }
-        s
-    } else {
-        lattice_scene(n, Model::Averaged).unwrap()
-    };
+    let mut d = Dumbbell::default();
+    if std::env::args().nth(2).as_deref() == Some("asymmetric") {
+        d.a2 = d.a1 / 2.0;
+    }
+    let s = lattice_scene_of(n, Model::Averaged, d).unwrap();
     let (y, base) = s.raw_state();
     let mut y = y.to_vec();
     for i in 0..n {

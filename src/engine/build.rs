@@ -154,9 +154,13 @@ pub fn random_suspension_apart(
 /// A cubic lattice of `swimmers` Fig-1 swimmers (symmetric, spacing 3ℓ, along x, phases spread
 /// over the period) for timings: every pair interacts.
 pub fn lattice_scene(swimmers: usize, model: Model) -> Result<Scene> {
+    lattice_scene_of(swimmers, model, Dumbbell::default())
+}
+
+/// [`lattice_scene`] of swimmers `d` (their phases spread over the period).
+pub fn lattice_scene_of(swimmers: usize, model: Model, d: Dumbbell) -> Result<Scene> {
     let mut s = Scene::new();
     s.set_model(model);
-    let d = Dumbbell::default();
     let side = (swimmers as f64).cbrt().ceil() as usize;
     let spacing = 3.0 * d.ell;
     for i in 0..swimmers {

@@ -28,12 +28,12 @@
 
 use super::mobility::Mobility;
 use super::periodic::PeriodicBox;
-use super::simd::{vector_dispatch, InvSqrt};
+use super::simd::{lane_sum, vector_dispatch, InvSqrt};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// Independent accumulators per row (one AVX-512 register, two AVX2 registers).
-pub const LANES: usize = 8;
+/// Independent accumulators per row.
+pub use super::simd::LANES;
 /// Rows per parallel task.
 const ROWS_PER_TASK: usize = 32;
 
@@ -221,12 +221,6 @@ fn add_overlapping(s: &SoaSpheres, k: Kernel, i: usize, out: &mut [f64; 3]) {
     }
 }
 
-/// Sum of the lanes in a fixed pairwise order.
-#[inline(always)]
-fn lane_sum(a: &[f64; LANES]) -> f64 {
-    ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]))
-}
-
 vector_dispatch! {
     /// [`rows_impl`] in the widest vector unit present.
     fn rows(s: &SoaSpheres, k: Kernel, first: usize, u: &mut [[f64; 3]]) = rows_impl;
@@ -387,17 +381,18 @@ fn half_row<U: InvSqrt, const MASK: bool>(
     ([lane_sum(&ax), lane_sum(&ay), lane_sum(&az)], check)
 }
 
-/// The spheres of `c` that sphere `i` overlaps (the pairs [`half_row`] masked).
-#[cold]
-fn overlapping_in(t: Tiled<'_>, i: usize, c: &Cols<'_>, out: &mut Vec<usize>) {
+/// The spheres of `c` that sphere `i` overlaps (the pairs [`half_row`] masks).
+fn overlapping_in<'a>(
+    t: Tiled<'a>,
+    i: usize,
+    c: &Cols<'_>,
+) -> impl Iterator<Item = usize> + use<'a> {
     let s = t.s;
-    for j in c.base..c.base + c.x.len() {
+    (c.base..c.base + c.x.len()).filter(move |&j| {
         let (rx, ry, rz) = (s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]);
         let contact = t.reach_a[i] + t.reach_a[j];
-        if rx * rx + ry * ry + rz * rz <= contact * contact {
-            out.push(j);
-        }
-    }
+        rx * rx + ry * ry + rz * rz <= contact * contact
+    })
 }
 
 /// For every pair of the tiles `rows` and `cols` (given by their accumulators), or of the tile
@@ -473,9 +468,7 @@ fn tile_pairs<'a, U: InvSqrt>(
         // is right for every other pair); coincident spheres (r² = 0) never are clear, nor a NaN.
         let clear = r2_min > contact * contact;
         if !overlap && !clear {
-            let mut found = Vec::new();
-            overlapping_in(t, i, c, &mut found);
-            overlap = !found.is_empty();
+            overlap = overlapping_in(t, i, c).next().is_some();
         }
         u
     });
@@ -493,7 +486,7 @@ fn tile_pairs<'a, U: InvSqrt>(
         let (u, m) = half_row::<U, true>(t, i, c);
         if m > 0.0 {
             masked.push(i);
-            overlapping_in(t, i, c, &mut masked);
+            masked.extend(overlapping_in(t, i, c));
         }
         u
     });

@@ -69,8 +69,15 @@ pub fn vector_unit() -> &'static str {
     "baseline"
 }
 
-/// Lanes of an [`InvSqrt`] block.
-pub const INV_SQRT_LANES: usize = 8;
+/// Independent accumulators of the vector kernels (one AVX-512 register, two AVX2 registers),
+/// and the lanes of an [`InvSqrt`] block.
+pub const LANES: usize = 8;
+
+/// Sum of the lanes in a fixed pairwise order.
+#[inline(always)]
+pub(crate) fn lane_sum(a: &[f64; LANES]) -> f64 {
+    ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]))
+}
 
 /// 1/√x for a block of lanes, the way one vector build computes it.
 ///
@@ -82,7 +89,7 @@ pub(crate) trait InvSqrt {
     ///
     /// # Safety
     /// The CPU has the vector unit the implementation names.
-    unsafe fn inv_sqrt(x: [f64; INV_SQRT_LANES]) -> [f64; INV_SQRT_LANES];
+    unsafe fn inv_sqrt(x: [f64; LANES]) -> [f64; LANES];
 }
 
 /// 1/√x as a square root and a division (within 1 ulp; the same bits in every vector width).
@@ -90,7 +97,7 @@ pub(crate) struct ExactInvSqrt;
 
 impl InvSqrt for ExactInvSqrt {
     #[inline(always)]
-    unsafe fn inv_sqrt(x: [f64; INV_SQRT_LANES]) -> [f64; INV_SQRT_LANES] {
+    unsafe fn inv_sqrt(x: [f64; LANES]) -> [f64; LANES] {
         x.map(|v| 1.0 / v.sqrt())
     }
 }
@@ -102,7 +109,7 @@ pub(crate) struct Avx512InvSqrt;
 
 impl InvSqrt for Avx512InvSqrt {
     #[inline(always)]
-    unsafe fn inv_sqrt(x: [f64; INV_SQRT_LANES]) -> [f64; INV_SQRT_LANES] {
+    unsafe fn inv_sqrt(x: [f64; LANES]) -> [f64; LANES] {
         #[cfg(target_arch = "x86_64")]
         {
             // SAFETY: the caller's contract: the CPU has AVX-512F (and FMA).
@@ -122,7 +129,7 @@ impl InvSqrt for Avx512InvSqrt {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,fma")]
 #[inline]
-unsafe fn avx512_inv_sqrt(x: [f64; INV_SQRT_LANES]) -> [f64; INV_SQRT_LANES] {
+unsafe fn avx512_inv_sqrt(x: [f64; LANES]) -> [f64; LANES] {
     use std::arch::x86_64::*;
     // SAFETY: both pointers cover 8 f64 (the array's length); unaligned loads and stores.
     unsafe {
@@ -132,7 +139,7 @@ unsafe fn avx512_inv_sqrt(x: [f64; INV_SQRT_LANES]) -> [f64; INV_SQRT_LANES] {
         let p = _mm512_fmadd_pd(_mm512_set1_pd(5.0 / 16.0), e, _mm512_set1_pd(3.0 / 8.0));
         let p = _mm512_fmadd_pd(p, e, _mm512_set1_pd(0.5));
         let y = _mm512_fmadd_pd(_mm512_mul_pd(y0, e), p, y0);
-        let mut out = [0.0; INV_SQRT_LANES];
+        let mut out = [0.0; LANES];
         _mm512_storeu_pd(out.as_mut_ptr(), y);
         out
     }
@@ -155,7 +162,7 @@ mod tests {
             let mut worst = 0.0f64;
             let mut state = 0x9e37_79b9_7f4a_7c15u64;
             for _ in 0..20_000 {
-                let x: [f64; INV_SQRT_LANES] = std::array::from_fn(|_| {
+                let x: [f64; LANES] = std::array::from_fn(|_| {
                     state ^= state << 13;
                     state ^= state >> 7;
                     state ^= state << 17;

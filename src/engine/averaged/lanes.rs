@@ -9,17 +9,11 @@
 //! another summation order.
 
 use super::{AveragedSystem, Coef, SIN_ZERO};
-use crate::engine::simd::vector_dispatch;
+use crate::engine::simd::{lane_sum, vector_dispatch};
 use nalgebra::Vector3;
 
 /// Partners per block.
-pub const LANES: usize = 8;
-
-/// Sum of the lanes in a fixed pairwise order.
-#[inline(always)]
-fn lane_sum(a: &[f64; LANES]) -> f64 {
-    ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]))
-}
+pub use crate::engine::simd::LANES;
 
 /// The prefactors of a row's J, L, I and K terms (I and K zero where the symmetric-swimmer
 /// shortcut drops them), each with its power of ℓ (ξ = ℓ/D): the lanes take powers of 1/D.
