@@ -144,7 +144,7 @@ fn former_hangs_are_refused_with_the_numbers() {
     );
     case(
         "let s = scene();\ns.add_random(dumbbell(), 1000000000, 0.01, 1);",
-        "at most 50000",
+        "at most 2000000",
         1,
     );
     case("sweep([1, 2], |p| p, 100000000);", "per core", 1);

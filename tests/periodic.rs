@@ -390,7 +390,7 @@ fn periodic_cell_lists_give_the_all_pairs_rates() {
                     },
                     1e-3,
                 );
-                sys.set_cell_lists(Some(cells));
+                sys.set_neighbour_lists(Some(cells));
                 let mut dy = vec![0.0; y.len()];
                 sys.rhs(0.0, y, &mut dy);
                 dy

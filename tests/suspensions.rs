@@ -100,7 +100,7 @@ fn cell_lists_give_the_all_pairs_rates() {
                     },
                     1e-3,
                 );
-                sys.set_cell_lists(Some(cells));
+                sys.set_neighbour_lists(Some(cells));
                 let mut dy = vec![0.0; y.len()];
                 sys.rhs(0.0, y, &mut dy);
                 dy
@@ -439,7 +439,7 @@ fn vector_lane_rows_equal_the_scalar_rows() {
                             shortcuts,
                         );
                         sys.set_cutoff(cutoff);
-                        sys.set_cell_lists(Some(false));
+                        sys.set_neighbour_lists(Some(false));
                         sys.set_contacts(
                             swimlab::engine::Contacts {
                                 allow_overlap: false,

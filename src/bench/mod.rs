@@ -8,5 +8,6 @@ pub mod plots;
 pub mod report;
 pub mod scaling;
 pub mod stability;
+pub mod suspension;
 pub mod table;
 pub mod work_precision;

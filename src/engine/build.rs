@@ -1,9 +1,11 @@
 //! Scene builders: random suspensions and lattices, seeded and reproducible.
 
+use super::cells::CellMap;
 use super::error::{invalid, require_positive, Result};
 use super::model::Model;
+use super::periodic::separation;
 use super::scene::Scene;
-use super::swimmer::Dumbbell;
+use super::swimmer::{unit_direction, Dumbbell};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 
@@ -59,9 +61,9 @@ pub enum Phases {
     Equal(f64),
 }
 
-/// Most swimmers one random placement may place: it tests each new swimmer against every placed
-/// one, so 50,000 swimmers take ~5e9 distance checks (seconds); more would run for minutes.
-pub const MAX_RANDOM_SWIMMERS: usize = 50_000;
+/// Most swimmers one random placement may place: a scene of 2e6 averaged swimmers holds ~0.3 GB
+/// and takes seconds a right-hand side; more is a memory exhaustion sooner than a simulation.
+pub const MAX_RANDOM_SWIMMERS: usize = 2_000_000;
 
 /// The side (m) of the cube holding `n` copies of `d` at sphere volume fraction `phi`.
 pub fn box_side(n: usize, d: &Dumbbell, phi: f64) -> Result<f64> {
@@ -92,7 +94,9 @@ pub fn random_suspension(
 }
 
 /// [`random_suspension`] with every sphere gap above `gap` (m) if given, instead of the default
-/// 4λ·max(w1, w2) the strokes can close.
+/// 4λ·max(w1, w2) the strokes can close. Each candidate is tested against the spheres in the cells
+/// around its own (cells as wide as the widest conflict, 2·largest radius + gap): O(1) per
+/// candidate, so placement is O(n).
 #[allow(clippy::too_many_arguments)]
 pub fn random_suspension_apart(
     scene: &mut Scene,
@@ -109,9 +113,10 @@ pub fn random_suspension_apart(
     }
     if n > MAX_RANDOM_SWIMMERS {
         return Err(invalid!(
-            "cannot place {n} swimmers at random in one call: placement checks every new swimmer against all placed ones (n^2/2 checks), so one call places at most {MAX_RANDOM_SWIMMERS}; place more on a lattice"
+            "cannot place {n} swimmers at random in one call: one call places at most {MAX_RANDOM_SWIMMERS} (a scene that size holds ~0.3 GB and takes seconds a step); place fewer"
         ));
     }
+    scene.check_placeable(&d)?;
     // Over a stroke a sphere moves by w·2λ along its axis (w = a_other/(a1+a2)): two spheres
     // placed further apart than 4λ·max(w1, w2) cannot be brought into contact by the strokes.
     let stroke = 4.0 * d.lambda * d.w1().max(d.w2());
@@ -122,6 +127,24 @@ pub fn random_suspension_apart(
         }
         None => stroke,
     };
+    let a_max = scene
+        .swimmers()
+        .iter()
+        .flat_map(|o| [o.a1, o.a2])
+        .fold(d.a1.max(d.a2), f64::max);
+    // The spheres placed so far: centres and radii, binned by centre.
+    let mut spheres = Spheres {
+        cells: CellMap::new(2.0 * a_max + margin, scene.periodic()),
+        centres: Vec::new(),
+        radii: Vec::new(),
+    };
+    for i in 0..scene.count() {
+        let (x1, x2) = scene.spheres(i);
+        let o = &scene.swimmers()[i];
+        spheres.insert(x1, o.a1);
+        spheres.insert(x2, o.a2);
+    }
+    let periodic = scene.periodic().copied();
     let mut rng = Rng::new(seed);
     let max_tries = 1000 * (n + 1);
     let mut tries = 0;
@@ -139,16 +162,45 @@ pub fn random_suspension_apart(
             Orientations::Random => rng.unit_vector(),
             Orientations::Aligned(v) => v,
         };
+        let dir = unit_direction(dir)?;
         let phase = match phases {
             Phases::Random => 2.0 * PI * rng.uniform(),
             Phases::Equal(p) => p,
         };
-        if scene.fits(&Dumbbell { phase, ..d }, c, dir, margin) {
-            scene.add(Dumbbell { phase, ..d }, c, dir)?;
+        let new = Dumbbell { phase, ..d };
+        let (x1, x2) = new.sphere_positions(c, dir, scene.contact_length(&new));
+        let clear = [(x1, d.a1), (x2, d.a2)].iter().all(|&(x, a)| {
+            spheres.cells.near(x.x, x.y, x.z, |k| {
+                let k = k as usize;
+                let gap = separation(periodic.as_ref(), x - spheres.centres[k]).norm()
+                    - a
+                    - spheres.radii[k];
+                gap > margin
+            })
+        });
+        if clear {
+            scene.push(new, c, dir);
+            spheres.insert(x1, d.a1);
+            spheres.insert(x2, d.a2);
             placed += 1;
         }
     }
     Ok(())
+}
+
+/// Placed spheres for [`random_suspension_apart`]: centres and radii, binned by centre.
+struct Spheres {
+    cells: CellMap,
+    centres: Vec<Vector3<f64>>,
+    radii: Vec<f64>,
+}
+
+impl Spheres {
+    fn insert(&mut self, x: Vector3<f64>, a: f64) {
+        self.cells.insert(x.x, x.y, x.z, self.radii.len() as u32);
+        self.centres.push(x);
+        self.radii.push(a);
+    }
 }
 
 /// A cubic lattice of `swimmers` Fig-1 swimmers (symmetric, spacing 3ℓ, along x, phases spread

@@ -12,58 +12,22 @@
 use super::periodic::PeriodicBox;
 use std::collections::HashMap;
 
-/// Points binned into cubic cells of side `size`, and ordered cell by cell.
-///
-/// In a periodic box the cells tile the box (n_d = ⌊L_d/size⌋ of side L_d/n_d ≥ size per axis) and
-/// the neighbours wrap around its faces; a pass measures its pairs by their minimum image. Every
-/// point within `size` ≤ L/2 of another is then among the 27 cells around it.
-#[derive(Debug, Clone, Default)]
-pub struct CellGrid {
+/// How points are binned: cubic cells of side `size`, or in a periodic box its tiling by
+/// n_d = ⌊L_d/size⌋ cells of side L_d/n_d ≥ size per axis.
+#[derive(Debug, Clone, Copy, Default)]
+struct Binning {
     size: f64,
-    /// The point indices, cell by cell (ascending within a cell).
-    pub order: Vec<u32>,
-    /// Each occupied cell's run `start..end` in `order`.
-    runs: HashMap<[i64; 3], (u32, u32)>,
     /// In a box: its sides and the cells per axis.
     periodic: Option<([f64; 3], [i64; 3])>,
 }
 
-impl CellGrid {
-    /// Bin the points (x[i], y[i], z[i]) into cells of side `size` (m, positive and finite).
-    pub fn build(x: &[f64], y: &[f64], z: &[f64], size: f64) -> Self {
-        Self::build_in(x, y, z, size, None)
-    }
-
-    /// [`CellGrid::build`] in periodic box `periodic`, if any.
-    pub fn build_in(
-        x: &[f64],
-        y: &[f64],
-        z: &[f64],
-        size: f64,
-        periodic: Option<&PeriodicBox>,
-    ) -> Self {
+impl Binning {
+    fn new(size: f64, periodic: Option<&PeriodicBox>) -> Self {
         let periodic = periodic.map(|b| {
             let l = b.sides();
             (l, l.map(|side| ((side / size).floor() as i64).max(1)))
         });
-        let mut grid = CellGrid {
-            size,
-            order: (0..x.len() as u32).collect(),
-            runs: HashMap::new(),
-            periodic,
-        };
-        let keys: Vec<[i64; 3]> = (0..x.len()).map(|i| grid.key(x[i], y[i], z[i])).collect();
-        grid.order.sort_by_key(|&i| (keys[i as usize], i));
-        let order = &grid.order;
-        let mut start = 0;
-        for k in 1..=order.len() {
-            if k == order.len() || keys[order[k] as usize] != keys[order[start] as usize] {
-                grid.runs
-                    .insert(keys[order[start] as usize], (start as u32, k as u32));
-                start = k;
-            }
-        }
-        grid
+        Binning { size, periodic }
     }
 
     fn key(&self, x: f64, y: f64, z: f64) -> [i64; 3] {
@@ -79,11 +43,9 @@ impl CellGrid {
         }
     }
 
-    /// Into `out` (cleared first), the runs in [`CellGrid::order`] of the 27 cells around
-    /// (x, y, z), in a fixed order: they hold every point within `size` of it.
-    pub fn neighbour_runs(&self, x: f64, y: f64, z: f64, out: &mut Vec<(u32, u32)>) {
-        out.clear();
-        let [i, j, k] = self.key(x, y, z);
+    /// The 27 cells around the cell `key` (wrapped in a box, each once), in a fixed order.
+    fn around(&self, key: [i64; 3], mut visit: impl FnMut([i64; 3])) {
+        let [i, j, k] = key;
         let mut seen: Vec<[i64; 3]> = Vec::new();
         for di in -1..=1 {
             for dj in -1..=1 {
@@ -101,11 +63,108 @@ impl CellGrid {
                             seen.push(cell);
                         }
                     }
-                    if let Some(&r) = self.runs.get(&cell) {
-                        out.push(r);
-                    }
+                    visit(cell);
                 }
             }
         }
+    }
+}
+
+/// Points binned into cubic cells of side `size`, and ordered cell by cell.
+///
+/// In a periodic box the cells tile the box (n_d = ⌊L_d/size⌋ of side L_d/n_d ≥ size per axis) and
+/// the neighbours wrap around its faces; a pass measures its pairs by their minimum image. Every
+/// point within `size` ≤ L/2 of another is then among the 27 cells around it.
+#[derive(Debug, Clone, Default)]
+pub struct CellGrid {
+    binning: Binning,
+    /// The point indices, cell by cell (ascending within a cell).
+    pub order: Vec<u32>,
+    /// Each occupied cell's run `start..end` in `order`.
+    runs: HashMap<[i64; 3], (u32, u32)>,
+}
+
+impl CellGrid {
+    /// Bin the points (x[i], y[i], z[i]) into cells of side `size` (m, positive and finite).
+    pub fn build(x: &[f64], y: &[f64], z: &[f64], size: f64) -> Self {
+        Self::build_in(x, y, z, size, None)
+    }
+
+    /// [`CellGrid::build`] in periodic box `periodic`, if any.
+    pub fn build_in(
+        x: &[f64],
+        y: &[f64],
+        z: &[f64],
+        size: f64,
+        periodic: Option<&PeriodicBox>,
+    ) -> Self {
+        let mut grid = CellGrid {
+            binning: Binning::new(size, periodic),
+            order: (0..x.len() as u32).collect(),
+            runs: HashMap::new(),
+        };
+        let keys: Vec<[i64; 3]> = (0..x.len())
+            .map(|i| grid.binning.key(x[i], y[i], z[i]))
+            .collect();
+        grid.order.sort_by_key(|&i| (keys[i as usize], i));
+        let order = &grid.order;
+        let mut start = 0;
+        for k in 1..=order.len() {
+            if k == order.len() || keys[order[k] as usize] != keys[order[start] as usize] {
+                grid.runs
+                    .insert(keys[order[start] as usize], (start as u32, k as u32));
+                start = k;
+            }
+        }
+        grid
+    }
+
+    /// Into `out` (cleared first), the runs in [`CellGrid::order`] of the 27 cells around
+    /// (x, y, z), in a fixed order: they hold every point within `size` of it.
+    pub fn neighbour_runs(&self, x: f64, y: f64, z: f64, out: &mut Vec<(u32, u32)>) {
+        out.clear();
+        self.binning.around(self.binning.key(x, y, z), |cell| {
+            if let Some(&r) = self.runs.get(&cell) {
+                out.push(r);
+            }
+        });
+    }
+}
+
+/// Points binned into cells as they come, for a set that grows while it is searched (random
+/// placement): the points within `size` of a point are among those [`CellMap::near`] visits.
+#[derive(Debug, Clone, Default)]
+pub struct CellMap {
+    binning: Binning,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl CellMap {
+    /// An empty map of cells of side `size` (m, positive and finite), in `periodic` if any.
+    pub fn new(size: f64, periodic: Option<&PeriodicBox>) -> Self {
+        CellMap {
+            binning: Binning::new(size, periodic),
+            cells: HashMap::new(),
+        }
+    }
+
+    /// Add point `id` at (x, y, z).
+    pub fn insert(&mut self, x: f64, y: f64, z: f64, id: u32) {
+        let key = self.binning.key(x, y, z);
+        self.cells.entry(key).or_default().push(id);
+    }
+
+    /// Call `visit` with every point in the 27 cells around (x, y, z), each once, until it
+    /// returns false; returns whether it never did.
+    pub fn near(&self, x: f64, y: f64, z: f64, mut visit: impl FnMut(u32) -> bool) -> bool {
+        let mut go_on = true;
+        self.binning.around(self.binning.key(x, y, z), |cell| {
+            if go_on {
+                if let Some(ids) = self.cells.get(&cell) {
+                    go_on = ids.iter().all(|&id| visit(id));
+                }
+            }
+        });
+        go_on
     }
 }

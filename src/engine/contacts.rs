@@ -18,6 +18,9 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+/// A rod: its start, the vector from start to end, and its radii at the two ends.
+pub(crate) type Rod = (Vector3<f64>, Vector3<f64>, [f64; 2]);
+
 /// Contact handling of a scene (saved with it).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Contacts {
@@ -139,9 +142,15 @@ impl Steric {
         i: usize,
         j: usize,
     ) -> Option<Vector3<f64>> {
-        let r = separation(periodic, pos[i] - pos[j]);
+        self.sphere_force(separation(periodic, pos[i] - pos[j]), radii[i], radii[j])
+    }
+
+    /// The repulsion on a sphere of radius `ai` from one of radius `aj` at separation `r` (its
+    /// centre minus the other's), if they are within reach.
+    #[inline]
+    pub(crate) fn sphere_force(&self, r: Vector3<f64>, ai: f64, aj: f64) -> Option<Vector3<f64>> {
         // Compare squares first: the square root is taken for the few close pairs only.
-        let reach = self.range + radii[i] + radii[j];
+        let reach = self.range + ai + aj;
         let d2 = r.norm_squared();
         (d2 < reach * reach && d2 > 0.0).then(|| {
             let d = d2.sqrt();
@@ -256,18 +265,59 @@ impl Steric {
         let d = mid(i) - mid(j);
         let shift = d - separation(periodic, d);
         let (q, d2) = (pos[2 * j] + shift, pos[2 * j + 1] - pos[2 * j]);
+        self.rod_pair_force(
+            (p, d1, [radii[2 * i], radii[2 * i + 1]]),
+            (q, d2, [radii[2 * j], radii[2 * j + 1]]),
+        )
+    }
+
+    /// The repulsion between rod `a` = (start, start-to-end, radii at both ends) and rod `b`, as
+    /// [`Steric::rod_force`]: the fraction s along `a` where it acts and the force on `a`.
+    #[inline]
+    pub(crate) fn rod_pair_force(&self, a: Rod, b: Rod) -> Option<(f64, Vector3<f64>)> {
+        let ((p, d1, ra), (q, d2, rb)) = (a, b);
         let (s, t) = closest_on_segments(&p, &d1, &q, &d2);
         let r = (p + d1 * s) - (q + d2 * t);
-        let reach = self.range
-            + (1.0 - s) * radii[2 * i]
-            + s * radii[2 * i + 1]
-            + (1.0 - t) * radii[2 * j]
-            + t * radii[2 * j + 1];
+        let reach = self.range + (1.0 - s) * ra[0] + s * ra[1] + (1.0 - t) * rb[0] + t * rb[1];
         let d2r = r.norm_squared();
         (d2r < reach * reach && d2r > 0.0).then(|| {
             let d = d2r.sqrt();
             (s, r * (self.stiffness * (reach - d) / d))
         })
+    }
+
+    /// The forces on swimmer A's two spheres (centres `a`, radii `ra`) from swimmer B's (`b`,
+    /// `rb`; B already at the image A meets), as [`Steric::add_forces`] adds them for this
+    /// body: per sphere pair, or rod to rod, the rod's force shared by its spheres.
+    #[inline]
+    pub(crate) fn swimmer_pair_forces(
+        &self,
+        a: [Vector3<f64>; 2],
+        ra: [f64; 2],
+        b: [Vector3<f64>; 2],
+        rb: [f64; 2],
+    ) -> [Vector3<f64>; 2] {
+        let mut f = [Vector3::zeros(); 2];
+        match self.body {
+            StericBody::Spheres => {
+                for k in 0..2 {
+                    for m in 0..2 {
+                        if let Some(df) = self.sphere_force(a[k] - b[m], ra[k], rb[m]) {
+                            f[k] += df;
+                        }
+                    }
+                }
+            }
+            StericBody::Rods => {
+                if let Some((s, df)) =
+                    self.rod_pair_force((a[0], a[1] - a[0], ra), (b[0], b[1] - b[0], rb))
+                {
+                    f[0] += df * (1.0 - s);
+                    f[1] += df * s;
+                }
+            }
+        }
+        f
     }
 
     /// [`Steric::add_forces`] between rods: the force on a rod at fraction s along it goes

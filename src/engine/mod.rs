@@ -22,6 +22,7 @@ pub mod integrators;
 pub mod micro;
 pub mod mobility;
 pub mod model;
+pub mod neighbours;
 pub mod observable;
 pub mod pairs;
 pub mod periodic;

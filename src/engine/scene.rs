@@ -184,6 +184,17 @@ impl Scene {
         d.validate()?;
         self.check_room(&d, center, dir, 0.0)?;
         let n = unit_direction(dir)?;
+        Ok(self.push(d, center, n))
+    }
+
+    /// Add swimmer `d` (valid) with hydrodynamic centre `center` and unit orientation `n`, its room
+    /// checked by the caller (random placement keeps its own cell lists). Returns its index.
+    pub(in crate::engine) fn push(
+        &mut self,
+        d: Dumbbell,
+        center: Vector3<f64>,
+        n: Vector3<f64>,
+    ) -> usize {
         let len = d.rest_length(self.time);
         self.swimmers.push(d);
         self.base.push(center);
@@ -193,7 +204,17 @@ impl Scene {
         };
         self.state
             .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
-        Ok(self.swimmers.len() - 1)
+        self.swimmers.len() - 1
+    }
+
+    /// Whether swimmer `d` can be placed in this scene at all: valid, and in a box short of
+    /// meeting its own image.
+    pub(in crate::engine) fn check_placeable(&self, d: &Dumbbell) -> Result<()> {
+        d.validate()?;
+        if let Some(b) = &self.periodic {
+            check_fits_box(d, b)?;
+        }
+        Ok(())
     }
 
     /// Whether [`Scene::add`] would accept this swimmer with every sphere gap above `margin` (m):
@@ -204,7 +225,7 @@ impl Scene {
 
     /// The length at which swimmer `d`'s spheres sit now: L(t), or ℓ in the averaged model, whose
     /// swimmers are stroke-averaged (its contact guard and steric repulsion use ℓ too).
-    fn contact_length(&self, d: &Dumbbell) -> f64 {
+    pub(in crate::engine) fn contact_length(&self, d: &Dumbbell) -> f64 {
         match self.model {
             Model::Averaged => d.ell,
             Model::Micro | Model::Rigid => d.rest_length(self.time),

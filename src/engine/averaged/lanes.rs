@@ -17,7 +17,7 @@ pub use crate::engine::simd::LANES;
 
 /// The prefactors of a row's J, L, I and K terms (I and K zero where the symmetric-swimmer
 /// shortcut drops them), each with its power of ℓ (ξ = ℓ/D): the lanes take powers of 1/D.
-fn prefactors(sys: &AveragedSystem, c: &Coef) -> [f64; 4] {
+pub(super) fn prefactors(sys: &AveragedSystem, c: &Coef) -> [f64; 4] {
     let with_i = if c.a_r != 0.0 || !sys.skip_symmetric {
         1.0
     } else {
@@ -52,7 +52,7 @@ struct Row {
 
 /// Accumulators of a row: Σ vn (the coefficient of the row's own orientation, applied once at
 /// the end), Σ D̂ jd (velocity) and Σ D̂ td (torque-like).
-type Acc = [f64; 7];
+pub(super) type Acc = [f64; 7];
 
 /// A partner's (position, orientation, sin φ, cos φ) contributions added to the row's
 /// accumulators. Skipped pairs (a zero phase difference, with `CUT` beyond the cutoff, and with
@@ -212,7 +212,7 @@ vector_dispatch! {
 /// q², shared among them.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn side<const IK: bool>(
+pub(super) fn side<const IK: bool>(
     k: [f64; 4],
     sin: f64,
     xi: f64,

@@ -10,15 +10,15 @@
 //! What a scene does not need is skipped: pairs with sin(φσ−φρ) = 0, the I and K terms of symmetric
 //! swimmers, and for an aligned scene the 3D algebra (the 1D reduction e:stroke_averaged).
 //!
-//! Why one file of ~630 lines (the vector-lane rows apart, in `lanes`): the terms, their
-//! shortcuts, the row loop over structure-of-arrays and its cutoff and contact guard form one
-//! right-hand side whose parts are checked against one another (tests/averaged_model.rs compares
-//! every shortcut with the general 3D sum); split, each piece would need the others' private
-//! layout.
+//! The terms, their shortcuts, the row loop over structure-of-arrays and its cutoff and contact
+//! guard live here; the all-pairs rows in vector lanes in `lanes`; a cutoff's rows over neighbour
+//! lists in `list_rows`, and the lists' upkeep, steric forces and contact guard in `listed`.
+//! tests/averaged_model.rs compares every shortcut with the general 3D sum.
 
 mod lanes;
+mod list_rows;
+mod listed;
 
-use super::cells::CellGrid;
 use super::contacts::Contacts;
 use super::integrators::{Noise, OdeSystem, Problem};
 use super::mobility::{self_mobility, Mobility};
@@ -173,13 +173,12 @@ pub struct AveragedSystem {
     gap_soa: SoaSpheres,
     contacts: Contacts,
     mu: f64,
-    /// Cell lists of the centres for a cutoff, rebuilt every right-hand side; `None`: all pairs.
-    grid: Option<CellGrid>,
-    /// The arrays in the grid's order (positions, orientations; sin φ, cos φ in `cell_phase`).
-    cell_soa: Soa,
-    cell_phase: Vec<(f64, f64)>,
-    /// Use cell lists: `None` decides by size ([`CELL_LIST_SWIMMERS`]).
-    cells: Option<bool>,
+    /// Use neighbour lists for a cutoff: `None` decides by size ([`LIST_SWIMMERS`]).
+    lists: Option<bool>,
+    /// The skin of the neighbour lists (m); `None`: [`DEFAULT_SKIN_OF_CUTOFF`] of the cutoff.
+    skin: Option<f64>,
+    /// The lists and their slot arrays (with a cutoff and lists in use).
+    listed: listed::Listed,
     /// Sum all-pairs rows in vector lanes: `None` decides by size ([`LANE_SWIMMERS`]).
     lanes: Option<bool>,
     /// Thermal noise: the seed and each swimmer's rigid-dumbbell diffusion.
@@ -192,9 +191,14 @@ pub struct AveragedSystem {
 /// the scalar rows, whose sums are in index order.
 pub const LANE_SWIMMERS: usize = 256;
 
-/// From this many swimmers a cutoff's pairs are found through cell lists: below it the all-pairs
-/// loop is as fast. The two differ only by the rounding of the sums' order ([`super::cells`]).
-pub const CELL_LIST_SWIMMERS: usize = 512;
+/// From this many swimmers a cutoff's pairs are summed over neighbour lists
+/// ([`super::neighbours`]): below it the all-pairs loop is as fast. The two differ only by the
+/// rounding of the sums' order.
+pub const LIST_SWIMMERS: usize = 256;
+
+/// The neighbour lists' skin as a fraction of the cutoff: a list holds pairs within 1.1 cutoffs
+/// (a third more pairs) and lasts until a swimmer has moved 0.05 cutoffs.
+pub const DEFAULT_SKIN_OF_CUTOFF: f64 = 0.05;
 
 impl AveragedSystem {
     /// A system for these swimmers with every shortcut; `y` is the current state (used to detect an
@@ -247,11 +251,10 @@ impl AveragedSystem {
             gap_soa: SoaSpheres::default(),
             contacts: Contacts::default(),
             mu: super::model::DEFAULT_MU,
-            grid: None,
-            cells: None,
+            lists: None,
+            skin: None,
+            listed: listed::Listed::default(),
             lanes: None,
-            cell_soa: Soa::default(),
-            cell_phase: Vec::new(),
             thermal: None,
             periodic: None,
         };
@@ -329,10 +332,21 @@ impl AveragedSystem {
         self.lanes = on;
     }
 
-    /// Force cell lists on or off for the cutoff's pairs (`None`: by size). They equal the
+    /// Force neighbour lists on or off for the cutoff's pairs (`None`: by size). They equal the
     /// all-pairs rows to the rounding of the summation order.
-    pub fn set_cell_lists(&mut self, on: Option<bool>) {
-        self.cells = on;
+    pub fn set_neighbour_lists(&mut self, on: Option<bool>) {
+        self.lists = on;
+    }
+
+    /// The neighbour lists' skin (m; `None`: [`DEFAULT_SKIN_OF_CUTOFF`] of the cutoff), shortened
+    /// in a box to keep the list within half the shortest side.
+    pub fn set_skin(&mut self, skin: Option<f64>) {
+        self.skin = skin;
+    }
+
+    /// How often the neighbour lists were built (0 without lists).
+    pub fn list_builds(&self) -> u64 {
+        self.listed.builds()
     }
 
     /// Leave out pairs further apart than `cutoff` (m); `None` keeps every pair.
@@ -462,27 +476,9 @@ impl AveragedSystem {
             }
             t += tr;
         };
-        match &self.grid {
-            None => {
-                for r in 0..self.coef.len() {
-                    if let Some(sin) = self.pair_sin(s, r) {
-                        pair(soa, r, sin);
-                    }
-                }
-            }
-            Some(g) => {
-                let mut runs = Vec::with_capacity(27);
-                g.neighbour_runs(soa.x[s], soa.y[s], soa.z[s], &mut runs);
-                for (a, b) in runs {
-                    for k in a as usize..b as usize {
-                        let r = g.order[k] as usize;
-                        let (sin_r, cos_r) = self.cell_phase[k];
-                        let sin = self.sin_phi[s] * cos_r - self.cos_phi[s] * sin_r;
-                        if s != r && (sin.abs() > SIN_ZERO || !self.skip_zero_phase) {
-                            pair(&self.cell_soa, k, sin);
-                        }
-                    }
-                }
+        for r in 0..self.coef.len() {
+            if let Some(sin) = self.pair_sin(s, r) {
+                pair(soa, r, sin);
             }
         }
         (v, t)
@@ -516,7 +512,6 @@ impl AveragedSystem {
         let count = self.coef.len();
         let parallel = count >= PARALLEL_SWIMMERS;
         let vector = self.axis.is_none()
-            && self.grid.is_none()
             && self.periodic.is_none()
             && self.lanes.unwrap_or(count >= LANE_SWIMMERS);
         let one = |s: usize, out: &mut [f64]| {
@@ -567,37 +562,14 @@ impl OdeSystem for AveragedSystem {
                     self.soa.nx[s] = vec3(y, STATE_PER_SWIMMER * s + 3).dot(&axis);
                 }
             }
-            None => {
-                self.fill(y);
-                let use_cells = self.cutoff2.is_finite()
-                    && self.cells.unwrap_or(self.coef.len() >= CELL_LIST_SWIMMERS);
-                self.grid = use_cells.then(|| {
-                    let soa = &self.soa;
-                    let side = self.cutoff2.sqrt();
-                    CellGrid::build_in(&soa.x, &soa.y, &soa.z, side, self.periodic.as_ref())
-                });
-                if let Some(g) = &self.grid {
-                    // Refilled in place: the buffers are allocated once, not per right-hand side.
-                    let (soa, cell) = (&self.soa, &mut self.cell_soa);
-                    for (to, from) in [
-                        (&mut cell.x, &soa.x),
-                        (&mut cell.y, &soa.y),
-                        (&mut cell.z, &soa.z),
-                        (&mut cell.nx, &soa.nx),
-                        (&mut cell.ny, &soa.ny),
-                        (&mut cell.nz, &soa.nz),
-                    ] {
-                        to.clear();
-                        to.extend(g.order.iter().map(|&i| from[i as usize]));
-                    }
-                    self.cell_phase.clear();
-                    self.cell_phase.extend(
-                        g.order
-                            .iter()
-                            .map(|&i| (self.sin_phi[i as usize], self.cos_phi[i as usize])),
-                    );
-                }
+            None => self.fill(y),
+        }
+        if self.uses_lists() {
+            self.update_list();
+            if let Some(st) = self.contacts.steric {
+                self.steric_by_list(st);
             }
+            return self.rows_by_list(y, dy);
         }
         if let Some(st) = self.contacts.steric {
             // The sphere models' pair force, on the spheres at length ℓ.
@@ -627,6 +599,10 @@ impl OdeSystem for AveragedSystem {
 
     fn check(&mut self, _t: f64, y: &[f64]) -> Result<(), Problem> {
         self.fill(y);
+        if self.uses_lists() {
+            self.update_list();
+            return self.check_by_list();
+        }
         let soa = &self.soa;
         let n = self.coef.len();
         let parallel = n >= PARALLEL_SWIMMERS;
@@ -640,7 +616,7 @@ impl OdeSystem for AveragedSystem {
                 })
                 .map(|r| (s, r))
         };
-        let found = if n >= CELL_LIST_SWIMMERS {
+        let found = if n >= LIST_SWIMMERS {
             // Only swimmers with bitwise equal centres share one: group them, O(S).
             let mut groups: std::collections::HashMap<[u64; 3], Vec<usize>> =
                 std::collections::HashMap::new();
@@ -665,12 +641,7 @@ impl OdeSystem for AveragedSystem {
             (0..n).find_map(shared_centre)
         };
         if let Some((s, r)) = found {
-            return Err(Problem {
-                swimmer: Some(s),
-                cause: format!("swimmers {s} and {r} have the same centre"),
-                hint: "start the swimmers apart: the averaged model is a far-field model".into(),
-                fixes: Vec::new(),
-            });
+            return Err(shared_centre_problem(s, r));
         }
         if self.contacts.allow_overlap {
             return Ok(());
@@ -732,5 +703,15 @@ impl OdeSystem for AveragedSystem {
             let n = vec3(y, i).normalize();
             set_vec3(y, i, &n);
         }
+    }
+}
+
+/// The guard's error for swimmers `s` and `r` at the same centre.
+fn shared_centre_problem(s: usize, r: usize) -> Problem {
+    Problem {
+        swimmer: Some(s),
+        cause: format!("swimmers {s} and {r} have the same centre"),
+        hint: "start the swimmers apart: the averaged model is a far-field model".into(),
+        fixes: Vec::new(),
     }
 }

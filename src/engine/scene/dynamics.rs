@@ -71,7 +71,8 @@ impl Scene {
         (&self.state, &self.base)
     }
 
-    pub(crate) fn system(&self) -> Result<Box<dyn OdeSystem>> {
+    /// The chosen model's right-hand side for the current settings (benchmarks and tests time and probe it).
+    pub fn system(&self) -> Result<Box<dyn OdeSystem>> {
         Ok(match self.model {
             Model::Micro => {
                 let mut sys = MicroSystem::new(
