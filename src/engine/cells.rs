@@ -154,6 +154,14 @@ impl CellMap {
         self.cells.entry(key).or_default().push(id);
     }
 
+    /// Take point `id` at (x, y, z) out (where it was inserted).
+    pub fn remove(&mut self, x: f64, y: f64, z: f64, id: u32) {
+        let key = self.binning.key(x, y, z);
+        if let Some(ids) = self.cells.get_mut(&key) {
+            ids.retain(|&i| i != id);
+        }
+    }
+
     /// Call `visit` with every point in the 27 cells around (x, y, z), each once, until it
     /// returns false; returns whether it never did.
     pub fn near(&self, x: f64, y: f64, z: f64, mut visit: impl FnMut(u32) -> bool) -> bool {

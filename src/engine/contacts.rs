@@ -79,7 +79,59 @@ pub struct Steric {
     /// What repels: the spheres alone, or each swimmer's whole body (saved; spheres for older files).
     #[serde(default)]
     pub body: StericBody,
+    /// How the force grows inside the range (saved only when not harmonic).
+    #[serde(default, skip_serializing_if = "StericLaw::is_harmonic")]
+    pub law: StericLaw,
 }
+
+/// How a steric force grows with the overlap x = δ − gap of the range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StericLaw {
+    /// F = k x: a spring from the edge of the range (default); its stiffness starts at once.
+    #[default]
+    Harmonic,
+    /// F = k x²/δ: the same force at contact (x = δ), growing from zero force and zero stiffness
+    /// at the edge of the range, so the rates have no kink where a contact starts. A contact held
+    /// near the edge by the far field then costs an adaptive step no more than the far field
+    /// does, where the harmonic law's kink holds it to a fraction of a period.
+    Smooth,
+}
+
+impl StericLaw {
+    fn is_harmonic(&self) -> bool {
+        *self == StericLaw::Harmonic
+    }
+
+    /// The force over the stiffness at overlap `x` of range `range` (m).
+    #[inline]
+    fn force(self, x: f64, range: f64) -> f64 {
+        match self {
+            StericLaw::Harmonic => x,
+            // Past contact (x > δ, overlapping bodies) the parabola's tangent carries on.
+            StericLaw::Smooth if x <= range => x * x / range,
+            StericLaw::Smooth => 2.0 * x - range,
+        }
+    }
+}
+
+impl Named for StericLaw {
+    const KIND: &'static str = "steric law";
+    const CHOICES: &'static [Choice<Self>] = &[
+        Choice {
+            value: StericLaw::Harmonic,
+            name: "harmonic",
+            about: "default: force stiffness * (range - gap)",
+        },
+        Choice {
+            value: StericLaw::Smooth,
+            name: "smooth",
+            about: "force stiffness * (range - gap)^2 / range: the same at contact, no kink at the range's edge",
+        },
+    ];
+}
+
+choice::inherent_names!(StericLaw);
 
 /// The bodies a steric repulsion keeps apart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -124,12 +176,18 @@ impl Steric {
             range,
             stiffness,
             body: StericBody::Spheres,
+            law: StericLaw::Harmonic,
         })
     }
 
     /// The same repulsion between other bodies.
     pub fn with_body(self, body: StericBody) -> Self {
         Steric { body, ..self }
+    }
+
+    /// The same repulsion with force law `law`.
+    pub fn with_law(self, law: StericLaw) -> Self {
+        Steric { law, ..self }
     }
 
     /// The repulsion on sphere `i` from sphere `j`, if they are within reach.
@@ -149,12 +207,26 @@ impl Steric {
     /// centre minus the other's), if they are within reach.
     #[inline]
     pub(crate) fn sphere_force(&self, r: Vector3<f64>, ai: f64, aj: f64) -> Option<Vector3<f64>> {
+        self.sphere_force_within(r, ai, aj, 0.0)
+    }
+
+    /// [`Steric::sphere_force`] with the law k (δ − gap) r̂ carried on, attractive, to gaps of
+    /// δ + `extra` (the linearly implicit methods' Jacobian of contacts about to form).
+    #[inline]
+    fn sphere_force_within(
+        &self,
+        r: Vector3<f64>,
+        ai: f64,
+        aj: f64,
+        extra: f64,
+    ) -> Option<Vector3<f64>> {
         // Compare squares first: the square root is taken for the few close pairs only.
         let reach = self.range + ai + aj;
+        let limit = reach + extra;
         let d2 = r.norm_squared();
-        (d2 < reach * reach && d2 > 0.0).then(|| {
+        (d2 < limit * limit && d2 > 0.0).then(|| {
             let d = d2.sqrt();
-            r * (self.stiffness * (reach - d) / d)
+            r * (self.stiffness * self.law.force(reach - d, self.range) / d)
         })
     }
 
@@ -275,14 +347,25 @@ impl Steric {
     /// [`Steric::rod_force`]: the fraction s along `a` where it acts and the force on `a`.
     #[inline]
     pub(crate) fn rod_pair_force(&self, a: Rod, b: Rod) -> Option<(f64, Vector3<f64>)> {
+        self.rod_pair_force_within(a, b, 0.0)
+    }
+
+    /// [`Steric::rod_pair_force`] carried on to gaps of δ + `extra`, as
+    /// [`Steric::sphere_force_within`].
+    #[inline]
+    fn rod_pair_force_within(&self, a: Rod, b: Rod, extra: f64) -> Option<(f64, Vector3<f64>)> {
         let ((p, d1, ra), (q, d2, rb)) = (a, b);
         let (s, t) = closest_on_segments(&p, &d1, &q, &d2);
         let r = (p + d1 * s) - (q + d2 * t);
         let reach = self.range + (1.0 - s) * ra[0] + s * ra[1] + (1.0 - t) * rb[0] + t * rb[1];
+        let limit = reach + extra;
         let d2r = r.norm_squared();
-        (d2r < reach * reach && d2r > 0.0).then(|| {
+        (d2r < limit * limit && d2r > 0.0).then(|| {
             let d = d2r.sqrt();
-            (s, r * (self.stiffness * (reach - d) / d))
+            (
+                s,
+                r * (self.stiffness * self.law.force(reach - d, self.range) / d),
+            )
         })
     }
 
@@ -297,21 +380,37 @@ impl Steric {
         b: [Vector3<f64>; 2],
         rb: [f64; 2],
     ) -> [Vector3<f64>; 2] {
+        self.swimmer_pair_forces_within(a, ra, b, rb, 0.0)
+    }
+
+    /// [`Steric::swimmer_pair_forces`] with the force law carried on to gaps of δ + `extra`.
+    #[inline]
+    pub(crate) fn swimmer_pair_forces_within(
+        &self,
+        a: [Vector3<f64>; 2],
+        ra: [f64; 2],
+        b: [Vector3<f64>; 2],
+        rb: [f64; 2],
+        extra: f64,
+    ) -> [Vector3<f64>; 2] {
         let mut f = [Vector3::zeros(); 2];
         match self.body {
             StericBody::Spheres => {
                 for k in 0..2 {
                     for m in 0..2 {
-                        if let Some(df) = self.sphere_force(a[k] - b[m], ra[k], rb[m]) {
+                        if let Some(df) = self.sphere_force_within(a[k] - b[m], ra[k], rb[m], extra)
+                        {
                             f[k] += df;
                         }
                     }
                 }
             }
             StericBody::Rods => {
-                if let Some((s, df)) =
-                    self.rod_pair_force((a[0], a[1] - a[0], ra), (b[0], b[1] - b[0], rb))
-                {
+                if let Some((s, df)) = self.rod_pair_force_within(
+                    (a[0], a[1] - a[0], ra),
+                    (b[0], b[1] - b[0], rb),
+                    extra,
+                ) {
                     f[0] += df * (1.0 - s);
                     f[1] += df * s;
                 }
@@ -470,6 +569,39 @@ mod tests {
         let pushed = all.iter().filter(|f| f.norm() > 0.0).count();
         assert!(pushed > 50, "only {pushed} spheres within reach");
         assert_eq!(by_cells, all);
+    }
+
+    /// The smooth law: the harmonic law's force at contact, none from the range on, and a slope
+    /// that starts from zero at the range (the harmonic law's jumps there from 0 to k); past
+    /// contact the tangent carries on. Tolerances: rounding of forces of size kδ (1e-12), and
+    /// the finite-difference slope's own error, h/δ = 1e-6.
+    #[test]
+    fn the_smooth_law_starts_without_a_kink() {
+        let (range, k, a) = (0.5e-6, 1e-4, 1e-6);
+        let harmonic = Steric::new(range, k).unwrap();
+        let smooth = harmonic.with_law(StericLaw::Smooth);
+        let at = |st: &Steric, gap: f64| {
+            st.sphere_force(Vector3::new(2.0 * a + gap, 0.0, 0.0), a, a)
+                .map_or(0.0, |f| f.x)
+        };
+        assert!((at(&smooth, 0.0) - at(&harmonic, 0.0)).abs() <= 1e-12 * k * range);
+        assert!((at(&smooth, 0.0) - k * range).abs() <= 1e-12 * k * range);
+        assert_eq!(at(&smooth, range), 0.0);
+        assert_eq!(at(&smooth, 2.0 * range), 0.0);
+        let h = 1e-6 * range;
+        let slope = |st: &Steric| (at(st, range - 2.0 * h) - at(st, range - h)) / h;
+        assert!(slope(&smooth).abs() < 1e-5 * k, "{:e}", slope(&smooth));
+        assert!(
+            (slope(&harmonic) - k).abs() < 1e-6 * k,
+            "{:e}",
+            slope(&harmonic)
+        );
+        // Past contact: F = k(2x − δ) at overlap x, slope 2k.
+        let x = 0.2 * range;
+        assert!(
+            (at(&smooth, -0.2 * range) - k * (2.0 * (range + x) - range)).abs()
+                <= 1e-12 * k * range
+        );
     }
 
     fn forces(st: &Steric, pos: &[Vector3<f64>], radii: &[f64]) -> Vec<Vector3<f64>> {

@@ -39,7 +39,7 @@ pub mod thermal;
 pub mod trajectory;
 
 pub use backend::Backend;
-pub use contacts::{Contacts, Overlaps, Steric, StericBody};
+pub use contacts::{Contacts, Overlaps, Steric, StericBody, StericLaw};
 pub use error::{EngineError, Result};
 pub use integrators::IntegratorSpec;
 pub use mobility::Mobility;

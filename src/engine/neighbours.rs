@@ -1,6 +1,11 @@
 //! Verlet neighbour lists of swimmer centres: each swimmer's partners within a list radius (the
-//! interaction's cutoff plus a skin), kept until some centre has moved more than half the skin
-//! since the build, so that no pair within the cutoff can be missing from them.
+//! interaction's cutoff plus a skin) of its *reference* centre, no pair within the cutoff missing
+//! while no centre has moved more than half the skin from its reference. Each swimmer keeps its
+//! own reference: one that moved further is *relisted* alone ([`NeighbourList::relist`]: its
+//! reference set to where it is, its row found anew, itself entered in its new partners' rows),
+//! so a few fast swimmers (a contact, a close pair) do not cost a rebuild of everyone's rows.
+//! The invariant: a pair is missing only if its reference centres are further apart than the
+//! radius; then its centres are further apart than the cutoff.
 //!
 //! The list also fixes a memory layout for the passes over it. Swimmers sit in *slots* ordered
 //! cell by cell ([`super::cells::CellGrid`]), so the partners of one swimmer lie close together
@@ -15,11 +20,16 @@
 //! weight is not zero, each with that weight, padded to whole blocks of [`LANES`] with a pad slot
 //! far away and weight 0) for the vector kernels, and *near* rows (every partner within a contact
 //! reach plus the skin, whatever its weight) for steric forces and the contact guard. Rows list
-//! partners in ascending slot order, so sums over them do not depend on the thread count.
+//! partners in ascending slot order (the pads last), so sums over them do not depend on the
+//! thread count. A relisted swimmer leaves stale entries nowhere: its old partners' entries for
+//! it are taken out before its new ones go in.
 
-use super::cells::CellGrid;
+use super::cells::{CellGrid, CellMap};
 use super::periodic::{nearest_integer, PeriodicBox};
 use super::simd::LANES;
+
+/// Rows of at least this many swimmers are found on rayon's threads.
+pub const PARALLEL_ROWS: usize = 256;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -60,44 +70,50 @@ impl ListSpec {
 #[derive(Debug, Clone)]
 pub struct NeighbourList {
     spec: ListSpec,
-    /// Centres (unwrapped) at the build.
+    /// The box's sides, in a box.
+    sides: Option<[f64; 3]>,
+    /// Each swimmer's reference centre (unwrapped).
     built: Vec<[f64; 3]>,
-    /// Slot k < n holds swimmer `order[k]`.
+    /// Slot k < n holds swimmer `order[k]`; slot n is the pad; ghosts follow.
     pub order: Vec<u32>,
+    /// Each swimmer's slot.
+    pub slot_of: Vec<u32>,
     /// Per swimmer, the lattice vector that moved its centre into the box at the build (0 in
     /// open space): its slot position is its centre plus this.
-    pub offset: Vec<[f64; 3]>,
-    /// Ghost slots n, n+1, …: (the slot they copy, the lattice vector added to it).
-    pub ghosts: Vec<(u32, [f64; 3])>,
-    /// Far rows of slot k: `far_partner[far_start[k]..far_start[k + 1]]`, whole blocks of LANES.
-    pub far_start: Vec<u32>,
-    /// Partner slots (the pad slot, [`NeighbourList::pad_slot`], fills the last block).
-    pub far_partner: Vec<u32>,
-    /// Each far entry's pair weight (0 for the pad).
-    pub far_weight: Vec<f64>,
-    /// Near rows of slot k: `near_partner[near_start[k]..near_start[k + 1]]`.
-    pub near_start: Vec<u32>,
-    /// Partner slots within the contact reach plus the skin.
-    pub near_partner: Vec<u32>,
-    /// Times this list was built (a rebuild counts).
-    pub builds: u64,
+    offset: Vec<[f64; 3]>,
+    /// Ghost slots n + 1, n + 2, …: (the slot they copy, the lattice vector added to it).
+    ghosts: Vec<(u32, [f64; 3])>,
+    /// The ghost slot of (slot, image in lattice steps).
+    ghost_of: HashMap<(u32, [i8; 3]), u32>,
+    /// Each swimmer's ghost slots.
+    ghosts_by_swimmer: Vec<Vec<u32>>,
+    /// Far rows by slot: partner slots (whole blocks of LANES, the pad last) and their weights.
+    far: Vec<(Vec<u32>, Vec<f64>)>,
+    /// Near rows by slot: partner slots.
+    near: Vec<Vec<u32>>,
+    /// The reference slot positions (reference centre plus offset), binned by the radius.
+    cells: CellMap,
+    /// Swimmers relisted so far.
+    pub relists: u64,
 }
 
-/// One partner found at a build: its slot, the image (lattice steps per axis) it is met at, its
-/// weight (`None`: not in the far rows), and whether it is near.
+/// One partner found: its swimmer, the image (lattice steps per axis) it is met at, its weight
+/// (`None`: not in the far rows), and whether it is near.
 type Found = (u32, [i8; 3], Option<f64>, bool);
+
+/// The pair weight of swimmers (i, j): `None` leaves the pair out of the far rows.
+pub type Weight<'a> = &'a (dyn Fn(usize, usize) -> Option<f64> + Sync);
 
 impl NeighbourList {
     /// A list of the centres (`x`, `y`, `z`: unwrapped, swimmer order) in periodic box
-    /// `periodic`, if any. `weight(i, j)` is the far-row weight of the pair (swimmer indices),
-    /// `None` to leave it out of the far rows.
+    /// `periodic`, if any, every reference where its centre is.
     pub fn build(
         x: &[f64],
         y: &[f64],
         z: &[f64],
         periodic: Option<&PeriodicBox>,
         spec: ListSpec,
-        weight: &(dyn Fn(usize, usize) -> Option<f64> + Sync),
+        weight: Weight,
     ) -> Self {
         let n = x.len();
         let centres: Vec<[f64; 3]> = (0..n).map(|s| [x[s], y[s], z[s]]).collect();
@@ -114,125 +130,203 @@ impl NeighbourList {
         let at = |s: usize, d: usize| centres[s][d] + offset[s][d];
         let coords = |d: usize| -> Vec<f64> { (0..n).map(|s| at(s, d)).collect() };
         let radius = spec.radius();
-        // Cells at least as wide as the radius: every partner is among the 27 cells around.
         let cell = if radius > 0.0 && radius.is_finite() {
             radius
         } else {
             1.0
         };
-        let grid = CellGrid::build_in(&coords(0), &coords(1), &coords(2), cell, periodic);
-        let order = grid.order.clone();
+        let order = CellGrid::build_in(&coords(0), &coords(1), &coords(2), cell, periodic).order;
         let mut slot_of = vec![0u32; n];
         for (k, &s) in order.iter().enumerate() {
             slot_of[s as usize] = k as u32;
         }
-        let sides = periodic.map(|b| b.sides());
-        let r2 = radius * radius;
-        let near2 = (spec.contact_reach + spec.skin).powi(2);
-        let with_near = spec.contact_reach > 0.0;
-        let find = |k: usize| -> Vec<Found> {
-            let i = order[k] as usize;
-            let mut runs = Vec::with_capacity(27);
-            grid.neighbour_runs(at(i, 0), at(i, 1), at(i, 2), &mut runs);
-            let mut found: Vec<Found> = Vec::new();
-            for (a, b) in runs {
-                for slot in a..b {
-                    let j = order[slot as usize] as usize;
-                    if j == i {
-                        continue;
-                    }
-                    let mut image = [0i8; 3];
-                    let mut d2 = 0.0;
-                    for (dim, m) in image.iter_mut().enumerate() {
-                        let mut d = at(i, dim) - at(j, dim);
-                        if let Some(l) = sides {
-                            // Slot positions lie in the box: the nearest image is 0 or ±1 away.
-                            let steps = nearest_integer(d / l[dim]);
-                            *m = steps as i8;
-                            d -= steps * l[dim];
-                        }
-                        d2 += d * d;
-                    }
-                    if d2 > r2 {
-                        continue;
-                    }
-                    let w = weight(i, j);
-                    let near = with_near && d2 <= near2;
-                    if w.is_some() || near {
-                        found.push((slot, image, w, near));
-                    }
-                }
-            }
-            found.sort_unstable_by_key(|f| (f.0, f.1));
-            found
+        let mut cells = CellMap::new(cell, periodic);
+        for s in 0..n {
+            cells.insert(at(s, 0), at(s, 1), at(s, 2), s as u32);
+        }
+        let mut list = NeighbourList {
+            spec,
+            sides: periodic.map(|b| b.sides()),
+            built: centres,
+            order,
+            slot_of,
+            offset,
+            ghosts: Vec::new(),
+            ghost_of: HashMap::new(),
+            ghosts_by_swimmer: vec![Vec::new(); n],
+            far: vec![(Vec::new(), Vec::new()); n],
+            near: vec![Vec::new(); n],
+            cells,
+            relists: 0,
         };
-        let rows: Vec<Vec<Found>> = if n >= super::averaged::PARALLEL_SWIMMERS {
+        let find = |k: usize| list.find(list.order[k] as usize, weight);
+        let rows: Vec<Vec<Found>> = if n >= PARALLEL_ROWS {
             (0..n).into_par_iter().map(find).collect()
         } else {
             (0..n).map(find).collect()
         };
-        // Ghost slots in the order rows first meet them: the list depends on the centres only.
-        let mut ghosts: Vec<(u32, [f64; 3])> = Vec::new();
-        let mut ghost_of: HashMap<(u32, [i8; 3]), u32> = HashMap::new();
-        let mut slot_for = |slot: u32, image: [i8; 3]| -> u32 {
-            if image == [0; 3] {
-                return slot;
+        for (k, row) in rows.into_iter().enumerate() {
+            list.set_row(k, row);
+        }
+        list
+    }
+
+    /// The reference slot position of swimmer `s` along axis `d`.
+    fn reference(&self, s: usize, d: usize) -> f64 {
+        self.built[s][d] + self.offset[s][d]
+    }
+
+    /// Swimmer `s`'s partners by the references: every swimmer within the radius, at the image
+    /// it is met at, in ascending (swimmer, image) order.
+    fn find(&self, s: usize, weight: Weight) -> Vec<Found> {
+        let r2 = self.spec.radius().powi(2);
+        let near2 = (self.spec.contact_reach + self.spec.skin).powi(2);
+        let with_near = self.spec.contact_reach > 0.0;
+        let p = [0, 1, 2].map(|d| self.reference(s, d));
+        let mut found: Vec<Found> = Vec::new();
+        self.cells.near(p[0], p[1], p[2], |j| {
+            let j = j as usize;
+            if j == s {
+                return true;
             }
-            *ghost_of.entry((slot, image)).or_insert_with(|| {
-                let l = sides.unwrap_or([0.0; 3]);
-                // The row meets the partner at its slot position plus `image` lattice steps.
-                let shift = [0, 1, 2].map(|d| f64::from(image[d]) * l[d]);
-                ghosts.push((slot, shift));
-                (n + ghosts.len() - 1) as u32
+            let mut image = [0i8; 3];
+            let mut d2 = 0.0;
+            for (d, m) in image.iter_mut().enumerate() {
+                let mut x = p[d] - self.reference(j, d);
+                if let Some(l) = self.sides {
+                    let steps = nearest_integer(x / l[d]);
+                    *m = steps as i8;
+                    x -= steps * l[d];
+                }
+                d2 += x * x;
+            }
+            if d2 <= r2 {
+                let w = weight(s, j);
+                let near = with_near && d2 <= near2;
+                if w.is_some() || near {
+                    found.push((j as u32, image, w, near));
+                }
+            }
+            true
+        });
+        found.sort_unstable_by_key(|f| (f.0, f.1));
+        found
+    }
+
+    /// The slot where a row meets swimmer `j` at `image`: its own, or a ghost (made if new).
+    fn slot_for(&mut self, j: u32, image: [i8; 3]) -> u32 {
+        let slot = self.slot_of[j as usize];
+        if image == [0; 3] {
+            return slot;
+        }
+        if let Some(&g) = self.ghost_of.get(&(slot, image)) {
+            return g;
+        }
+        let l = self.sides.unwrap_or([0.0; 3]);
+        let shift = [0, 1, 2].map(|d| f64::from(image[d]) * l[d]);
+        let g = (self.order.len() + 1 + self.ghosts.len()) as u32;
+        self.ghosts.push((slot, shift));
+        self.ghost_of.insert((slot, image), g);
+        self.ghosts_by_swimmer[j as usize].push(g);
+        g
+    }
+
+    /// Row `k`'s far and near entries from `found`, in ascending slot order, the far ones padded.
+    fn set_row(&mut self, k: usize, found: Vec<Found>) {
+        let mut far: Vec<(u32, f64)> = Vec::new();
+        let mut near: Vec<u32> = Vec::new();
+        for (j, image, w, is_near) in found {
+            let slot = self.slot_for(j, image);
+            if let Some(w) = w {
+                far.push((slot, w));
+            }
+            if is_near {
+                near.push(slot);
+            }
+        }
+        far.sort_unstable_by_key(|e| e.0);
+        near.sort_unstable();
+        let row = &mut self.far[k];
+        row.0 = far.iter().map(|e| e.0).collect();
+        row.1 = far.iter().map(|e| e.1).collect();
+        pad(row, self.order.len() as u32);
+        self.near[k] = near;
+    }
+
+    /// Relist swimmer `s`, now at `c` (unwrapped): its reference set there, its entries taken out
+    /// of its old partners' rows, its row found anew, and itself entered in its new partners'
+    /// rows. Returns whether ghost slots were added (the slot arrays then need refilling).
+    pub fn relist(&mut self, s: usize, c: [f64; 3], weight: Weight) -> bool {
+        let ghosts_before = self.ghosts.len();
+        let k = self.slot_of[s] as usize;
+        let p = [0, 1, 2].map(|d| self.reference(s, d));
+        self.cells.remove(p[0], p[1], p[2], s as u32);
+        // Its old partners' entries for it (its slot or a ghost of it) go.
+        let own: Vec<u32> = std::iter::once(k as u32)
+            .chain(self.ghosts_by_swimmer[s].iter().copied())
+            .collect();
+        let old: Vec<usize> = self.far[k]
+            .0
+            .iter()
+            .chain(&self.near[k])
+            .filter(|&&q| (q as usize) != self.order.len())
+            .map(|&q| self.swimmer_of(q as usize))
+            .collect();
+        let pad_slot = self.order.len() as u32;
+        for j in old {
+            let kj = self.slot_of[j] as usize;
+            let row = &mut self.far[kj];
+            let keep: Vec<(u32, f64)> = row
+                .0
+                .iter()
+                .zip(&row.1)
+                .filter(|(q, _)| **q != pad_slot && !own.contains(q))
+                .map(|(q, w)| (*q, *w))
+                .collect();
+            row.0 = keep.iter().map(|e| e.0).collect();
+            row.1 = keep.iter().map(|e| e.1).collect();
+            pad(row, pad_slot);
+            self.near[kj].retain(|q| !own.contains(q));
+        }
+        self.built[s] = c;
+        let p = [0, 1, 2].map(|d| self.reference(s, d));
+        self.cells.insert(p[0], p[1], p[2], s as u32);
+        let found = self.find(s, weight);
+        // Each new partner j meets s at the opposite image.
+        let back: Vec<(usize, [i8; 3], Option<f64>, bool)> = found
+            .iter()
+            .map(|&(j, image, _, near)| {
+                let j = j as usize;
+                (j, image.map(|m| -m), weight(j, s), near)
             })
-        };
-        let mut far_start = Vec::with_capacity(n + 1);
-        let mut near_start = Vec::with_capacity(n + 1);
-        let total: usize = rows.iter().map(Vec::len).sum();
-        let mut far_partner = Vec::with_capacity(total + LANES * n);
-        let mut far_weight = Vec::with_capacity(total + LANES * n);
-        let mut near_partner = Vec::new();
-        let mut pads = Vec::new();
-        for row in &rows {
-            far_start.push(far_partner.len() as u32);
-            near_start.push(near_partner.len() as u32);
-            for &(slot, image, w, near) in row {
-                let s = slot_for(slot, image);
-                if let Some(w) = w {
-                    far_partner.push(s);
-                    far_weight.push(w);
-                }
-                if near {
-                    near_partner.push(s);
-                }
+            .collect();
+        self.set_row(k, found);
+        for (j, image, w, near) in back {
+            let slot = self.slot_for(s as u32, image);
+            let kj = self.slot_of[j] as usize;
+            if let Some(w) = w {
+                let row = &mut self.far[kj];
+                let mut entries: Vec<(u32, f64)> = row
+                    .0
+                    .iter()
+                    .zip(&row.1)
+                    .filter(|(q, _)| **q != pad_slot)
+                    .map(|(q, w)| (*q, *w))
+                    .collect();
+                let at = entries.partition_point(|e| e.0 < slot);
+                entries.insert(at, (slot, w));
+                row.0 = entries.iter().map(|e| e.0).collect();
+                row.1 = entries.iter().map(|e| e.1).collect();
+                pad(row, pad_slot);
             }
-            while !(far_partner.len() - *far_start.last().unwrap_or(&0) as usize)
-                .is_multiple_of(LANES)
-            {
-                pads.push(far_partner.len());
-                far_partner.push(0);
-                far_weight.push(0.0);
+            if near {
+                let row = &mut self.near[kj];
+                let at = row.partition_point(|&q| q < slot);
+                row.insert(at, slot);
             }
         }
-        far_start.push(far_partner.len() as u32);
-        near_start.push(near_partner.len() as u32);
-        let pad = (n + ghosts.len()) as u32;
-        for p in pads {
-            far_partner[p] = pad;
-        }
-        NeighbourList {
-            spec,
-            built: centres,
-            order,
-            offset,
-            ghosts,
-            far_start,
-            far_partner,
-            far_weight,
-            near_start,
-            near_partner,
-            builds: 1,
-        }
+        self.relists += 1;
+        self.ghosts.len() > ghosts_before
     }
 
     /// The spec the list was built for.
@@ -250,74 +344,103 @@ impl NeighbourList {
         self.order.is_empty()
     }
 
-    /// Slots in all: swimmers, ghosts, and the pad.
+    /// Slots in all: swimmers, the pad, and ghosts.
     pub fn slots(&self) -> usize {
-        self.order.len() + self.ghosts.len() + 1
+        self.order.len() + 1 + self.ghosts.len()
     }
 
     /// The pad slot: far away from every swimmer, weight 0 in every row it fills.
     pub fn pad_slot(&self) -> usize {
-        self.slots() - 1
+        self.order.len()
+    }
+
+    /// Slot `k`'s far row: partner slots (whole blocks of LANES) and their weights.
+    pub fn far_row(&self, k: usize) -> (&[u32], &[f64]) {
+        let (p, w) = &self.far[k];
+        (p, w)
+    }
+
+    /// Slot `k`'s near row: partner slots.
+    pub fn near_row(&self, k: usize) -> &[u32] {
+        &self.near[k]
     }
 
     /// Far entries in all (pads included).
     pub fn far_entries(&self) -> usize {
-        self.far_partner.len()
+        self.far.iter().map(|r| r.0.len()).sum()
     }
 
-    /// Whether the list still holds every pair for the centres `x`, `y`, `z` (unwrapped, swimmer
-    /// order): no centre has moved more than half the skin since the build (with no skin, none
-    /// has moved at all).
-    pub fn is_valid_for(&self, x: &[f64], y: &[f64], z: &[f64]) -> bool {
-        if x.len() != self.built.len() {
-            return false;
-        }
-        let limit = 0.25 * self.spec.skin * self.spec.skin;
-        self.built.iter().enumerate().all(|(s, b)| {
-            let d2 = (x[s] - b[0]).powi(2) + (y[s] - b[1]).powi(2) + (z[s] - b[2]).powi(2);
-            d2 <= limit
-        })
+    /// The swimmers whose centres (`x`, `y`, `z`: unwrapped, swimmer order) have moved more than
+    /// half the skin from their references (with no skin, at all).
+    pub fn moved(&self, x: &[f64], y: &[f64], z: &[f64]) -> Vec<usize> {
+        (0..self.built.len())
+            .filter(|&s| !self.holds(s, x[s], y[s], z[s]))
+            .collect()
+    }
+
+    /// Whether swimmer `s` at (x, y, z) is still within half the skin of its reference.
+    pub fn holds(&self, s: usize, x: f64, y: f64, z: f64) -> bool {
+        let b = self.built[s];
+        (x - b[0]).powi(2) + (y - b[1]).powi(2) + (z - b[2]).powi(2)
+            <= 0.25 * self.spec.skin * self.spec.skin
     }
 
     /// Fill `out` (each resized to [`NeighbourList::slots`]) with the slot positions of the centres
-    /// `x`, `y`, `z` (unwrapped, swimmer order): swimmers, ghosts, and the pad far away.
+    /// `x`, `y`, `z` (unwrapped, swimmer order): swimmers, the pad far away, ghosts.
     pub fn fill_positions(&self, centres: [&[f64]; 3], out: [&mut Vec<f64>; 3]) {
-        let mut out = out;
-        for (d, v) in out.iter_mut().enumerate() {
+        for (d, v) in out.into_iter().enumerate() {
             v.clear();
             v.extend(self.order.iter().map(|&s| {
                 let s = s as usize;
                 centres[d][s] + self.offset[s][d]
             }));
-        }
-        for &(slot, shift) in &self.ghosts {
-            for (d, v) in out.iter_mut().enumerate() {
+            v.push(PAD_POSITION);
+            for &(slot, shift) in &self.ghosts {
                 let p = v[slot as usize] + shift[d];
                 v.push(p);
             }
         }
-        for v in out.iter_mut() {
-            v.push(PAD_POSITION);
-        }
     }
 
-    /// Fill `v` (resized to [`NeighbourList::slots`]) with per-swimmer values in slot order: a
-    /// ghost takes its swimmer's value, the pad `pad`.
+    /// Fill `v` (resized to [`NeighbourList::slots`]) with per-swimmer values in slot order: the
+    /// pad `pad`, a ghost its swimmer's value.
     pub fn fill_values<T: Copy>(&self, of: impl Fn(usize) -> T, pad: T, v: &mut Vec<T>) {
         v.clear();
         v.extend(self.order.iter().map(|&s| of(s as usize)));
+        v.push(pad);
         for &(slot, _) in &self.ghosts {
             let x = v[slot as usize];
             v.push(x);
         }
-        v.push(pad);
     }
 
-    /// The swimmer in slot `slot` (a ghost's is its original's).
+    /// Set swimmer `s`'s entries of the slot arrays `out` (filled by
+    /// [`NeighbourList::fill_positions`]) from its centre `c` (unwrapped): its slot and its ghosts.
+    pub fn set_position(&self, s: usize, c: [f64; 3], out: [&mut [f64]; 3]) {
+        let slot = self.slot_of[s] as usize;
+        for (d, v) in out.into_iter().enumerate() {
+            let p = c[d] + self.offset[s][d];
+            v[slot] = p;
+            for &g in &self.ghosts_by_swimmer[s] {
+                v[g as usize] = p + self.ghosts[g as usize - self.order.len() - 1].1[d];
+            }
+        }
+    }
+
+    /// Set swimmer `s`'s value `x` in per-slot values `v` (filled by
+    /// [`NeighbourList::fill_values`]): its slot and its ghosts.
+    pub fn set_value<T: Copy>(&self, s: usize, x: T, v: &mut [T]) {
+        v[self.slot_of[s] as usize] = x;
+        for &g in &self.ghosts_by_swimmer[s] {
+            v[g as usize] = x;
+        }
+    }
+
+    /// The swimmer in slot `slot` (a ghost's is its original's; not the pad).
     pub fn swimmer_of(&self, slot: usize) -> usize {
         let n = self.order.len();
-        let slot = if slot >= n && slot < n + self.ghosts.len() {
-            self.ghosts[slot - n].0 as usize
+        let slot = if slot > n {
+            self.ghosts[slot - n - 1].0 as usize
         } else {
             slot
         };
@@ -325,6 +448,14 @@ impl NeighbourList {
     }
 }
 
-/// Where the pad slot sits (m): its squared distance from any swimmer overflows to infinity, so
-/// every cutoff test leaves it out.
-pub const PAD_POSITION: f64 = 1e300;
+/// Fill a far row up to whole blocks of LANES with the pad slot, weight 0.
+fn pad(row: &mut (Vec<u32>, Vec<f64>), pad_slot: u32) {
+    while !row.0.len().is_multiple_of(LANES) {
+        row.0.push(pad_slot);
+        row.1.push(0.0);
+    }
+}
+
+/// Where the pad slot sits (m): further from any swimmer than any cutoff, with a squared distance
+/// that stays finite (≈ 1e300).
+pub const PAD_POSITION: f64 = 1e150;

@@ -10,7 +10,7 @@ use crate::engine::ewald::EwaldMethod;
 use crate::engine::integrators::METHODS;
 use crate::engine::thermal::NoiseRoot;
 use crate::engine::{
-    Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric, StericBody,
+    Backend, Coefficients, IntegratorSpec, Mobility, Model, Scene, Steric, StericBody, StericLaw,
 };
 use rhai::{Dynamic, Engine, ImmutableString, INT};
 
@@ -23,7 +23,7 @@ fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {
 
 /// `s.steric = #{ range, stiffness[, body] }` (m, N/m, "spheres" or "rods") or `()` for none.
 fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
-    const FIX: &str = "use s.steric = #{ range: 1e-7, stiffness: 1e-3 } (m, N/m; add body: \"rods\" to keep whole swimmers apart), or s.steric = () for none";
+    const FIX: &str = "use s.steric = #{ range: 1e-7, stiffness: 1e-3 } (m, N/m; add body: \"rods\" to keep whole swimmers apart, law: \"smooth\" for a force without a kink), or s.steric = () for none";
     if v.is_unit() {
         return Ok(None);
     }
@@ -33,11 +33,13 @@ fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
         )));
     };
     let (mut range, mut stiffness, mut body) = (None, None, StericBody::Spheres);
+    let mut law = StericLaw::Harmonic;
     for (k, val) in &map {
         match k.as_str() {
             "range" => range = Some(number("steric range", val)?),
             "stiffness" => stiffness = Some(number("steric stiffness", val)?),
             "body" => body = lift(StericBody::parse(&string_arg("steric body", val)?))?,
+            "law" => law = lift(StericLaw::parse(&string_arg("steric law", val)?))?,
             other => {
                 return Err(script_error(format!(
                     "s.steric: unknown key \"{other}\"; {FIX}"
@@ -46,7 +48,9 @@ fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
         }
     }
     match (range, stiffness) {
-        (Some(r), Some(k)) => lift(Steric::new(r, k)).map(|st| Some(st.with_body(body))),
+        (Some(r), Some(k)) => {
+            lift(Steric::new(r, k)).map(|st| Some(st.with_body(body).with_law(law)))
+        }
         _ => Err(script_error(format!(
             "s.steric needs both range and stiffness; {FIX}"
         ))),
@@ -202,6 +206,7 @@ pub fn register(engine: &mut Engine) {
                 m.insert("range".into(), Dynamic::from_float(st.range));
                 m.insert("stiffness".into(), Dynamic::from_float(st.stiffness));
                 m.insert("body".into(), Dynamic::from(st.body.name().to_string()));
+                m.insert("law".into(), Dynamic::from(st.law.name().to_string()));
                 Dynamic::from_map(m)
             }
             None => Dynamic::UNIT,
@@ -274,7 +279,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("backend_info", "numerics", "s.backend_info -> string", "Which backend the next run uses and why (for \"auto\": the measured crossover).", "let s = scene(); print(s.backend_info);"),
     doc_entry!("mobility", "numerics", "s.mobility -> string\ns.mobility = \"rpy\" | \"oseen\"", "Pair mobility of the microscopic model: Rotne-Prager-Yamakawa (default) or Oseen.", "let s = scene(); s.mobility = \"oseen\"; print(s.mobility);"),
     doc_entry!("overlaps", "numerics", "s.overlaps -> string\ns.overlaps = \"stop\" | \"allow\"", "What happens when spheres of different swimmers touch: \"stop\" (default) ends the run with an error naming them; \"allow\" lets them overlap, moved by the RPY tensor for overlapping spheres (Zuk et al. 2014, positive definite; the averaged model, a far-field model, then runs on with its D^-5 terms). A swimmer's own spheres touching always stops the run. CPU only.", "let s = scene(); s.overlaps = \"allow\"; print(s.overlaps);"),
-    doc_entry!("steric", "numerics", "s.steric -> map or ()\ns.steric = #{ range, stiffness[, body] } | ()", "A soft repulsion between swimmers: force stiffness * (range - gap) (N) when their surface gap is below range (m). Off by default (). body: \"spheres\" (default) repels spheres of different swimmers along their line of centres; \"rods\" treats each swimmer as a rod from sphere to sphere, thickened by the radii, so swimmers can neither touch nor pass through each other (the force acts at the rods' closest points, shared by the two spheres). Microscopic model: the forces join the spring forces in the mobility. Averaged model: each swimmer moves as a free-draining rigid dumbbell of length ell under them. Not in the rigid-stroke model; CPU only; one pass per right-hand side through cell lists in large scenes.", "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3, body: \"rods\" }; print(s.steric.body);"),
+    doc_entry!("steric", "numerics", "s.steric -> map or ()\ns.steric = #{ range, stiffness[, body, law] } | ()", "A soft repulsion between swimmers: force stiffness * (range - gap) (N) when their surface gap is below range (m). Off by default (). law: \"harmonic\" (default) as written; \"smooth\" stiffness * (range - gap)^2 / range, the same force at contact but starting with no kink, which adaptive steps cross far more cheaply (suspensions held in contact by the far field). body: \"spheres\" (default) repels spheres of different swimmers along their line of centres; \"rods\" treats each swimmer as a rod from sphere to sphere, thickened by the radii, so swimmers can neither touch nor pass through each other (the force acts at the rods' closest points, shared by the two spheres; those points jump from end to end as two rods in contact turn through parallel, a jump in the torque: adaptive steps stall on two rods held exactly parallel in contact). Microscopic model: the forces join the spring forces in the mobility. Averaged model: each swimmer moves as a free-draining rigid dumbbell of length ell under them. Not in the rigid-stroke model; CPU only; one pass per right-hand side through cell lists in large scenes.", "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3, body: \"rods\" }; print(s.steric.body);"),
     doc_entry!("cutoff", "numerics", "s.cutoff -> float or ()\ns.cutoff = distance | ()", "Far-field cutoff of the averaged model (m): pairs further apart are left out. Off by default (). Each left-out pair's contribution is bounded by 9/64 v0 (28|A_R|(Lambda/ell) xi^3 + 84 c_J xi^4) with xi = ell/cutoff (README, Suspensions).", "let s = scene(); s.cutoff = 100e-6; print(s.cutoff);"),
     doc_entry!("box", "numerics", "s.box -> array or ()\ns.box = [Lx, Ly, Lz] | ()", "A periodic box of these sides (m) centred on the origin (-L/2 to L/2), or () for open space (the default). Pairs are measured by their minimum images; the sphere models use the periodic RPY (or Oseen) mobility by Ewald summation (Beenakker 1986, or spectral Ewald for many spheres: s.ewald_method; to s.ewald_tol, no net flow); the averaged model sums pairs within a cutoff of at most L/2 (L/2 when s.cutoff is not set). Snapshots, trajectories and fields show positions wrapped into the box; displacements and drift observables follow the unwrapped motion. add_random fills the box (s.add_random(d, n, seed)). CPU only. Saved with the scene.", "let s = scene(); s.box = [200e-6, 200e-6, 200e-6]; s.add_random(dumbbell(), 20, 1); print(s.box);"),
     doc_entry!("ewald_method", "numerics", "s.ewald_method -> string\ns.ewald_method = \"auto\" | \"beenakker\" | \"spectral\"", "How the box's mobility products are summed for the spring model, s.sphere_velocities and the Lanczos noise root: \"beenakker\" sums over images and waves (O(N^2) per product); \"spectral\" is spectral Ewald (Lindbo & Tornberg 2010, the wave part of Fiore et al.'s positively split Ewald): real-space pairs within a cutoff of at most L/2 through cell lists, the wave part on an FFT grid (O(N log N)); \"auto\" (default) takes Beenakker below 700 spheres and spectral from there (the measured crossover, swimlab bench ewald). Both keep s.ewald_tol. The rigid model's constraint solve and the dense noise root take blocks, which are always Beenakker's. Saved with the scene.", "let s = scene(); s.ewald_method = \"spectral\"; print(s.ewald_method);"),

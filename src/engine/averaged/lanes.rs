@@ -8,7 +8,7 @@
 //! neither the thread count nor the vector width, and equals the scalar row's to the rounding of
 //! another summation order.
 
-use super::{AveragedSystem, Coef, SIN_ZERO};
+use super::{AveragedSystem, Coef, CutoffSwitch, SIN_ZERO};
 use crate::engine::simd::{lane_sum, vector_dispatch};
 use nalgebra::Vector3;
 
@@ -48,6 +48,7 @@ struct Row {
     /// skipped, −1 (every pair) when not.
     sin_floor: f64,
     cutoff2: f64,
+    switch: CutoffSwitch,
 }
 
 /// Accumulators of a row: Σ vn (the coefficient of the row's own orientation, applied once at
@@ -83,6 +84,11 @@ fn lane_term<const OWN: bool, const CUT: bool, const IK: bool>(
     // zero terms finite.
     let d2 = if keep { d2 } else { 1.0 };
     let inv = 1.0 / d2.sqrt();
+    let sin = if CUT {
+        sin * p.switch.at(d2 * inv)
+    } else {
+        sin
+    };
     let h = [dx * inv, dy * inv, dz * inv];
     let dot = |u: [f64; 3], v: [f64; 3]| u[0].mul_add(v[0], u[1].mul_add(v[1], u[2] * v[2]));
     let (a, b) = (p.n, [bx, by, bz]);
@@ -121,6 +127,7 @@ fn row_with<'a, const CUT: bool, const IK: bool>(
         k,
         sin_floor: if sys.skip_zero_phase { SIN_ZERO } else { -1.0 },
         cutoff2: sys.cutoff2,
+        switch: sys.switch,
     };
     let mut acc = [[0.0; LANES]; 7];
     let blocks = n / LANES;

@@ -2,12 +2,12 @@
 //! arithmetic ([`super::lanes::side`]) over each row's far partners, [`LANES`] at a time. A block
 //! gathers its partners' slot positions and orientations; the pair's phase sine is the list's
 //! weight, fixed at the build; pairs beyond the cutoff (the list holds the skin too) and the pad
-//! get 1/D = 0 by a select, which zeroes every term. Slot positions already carry the image each pair is met at, so a
+//! get 1/D = 0 by a select, which zeroes every term; the cutoff's switch weighs the rest. Slot positions already carry the image each pair is met at, so a
 //! pair is a plain difference. Each lane accumulates its own partners and the lanes are summed
 //! in a fixed order: a row depends on neither the thread count nor the vector width.
 
 use super::lanes::{prefactors, side, Acc};
-use super::{AveragedSystem, Soa};
+use super::{AveragedSystem, CutoffSwitch, Soa};
 use crate::engine::neighbours::NeighbourList;
 use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
 use nalgebra::Vector3;
@@ -21,6 +21,7 @@ fn list_term<const IK: bool>(
     n: &[f64; 3],
     k: [f64; 4],
     cutoff2: f64,
+    switch: CutoffSwitch,
     p: [f64; 7],
     acc: Acc,
 ) -> Acc {
@@ -30,6 +31,7 @@ fn list_term<const IK: bool>(
     // A pair beyond the cutoff (or the pad, whose d² is infinite) gets 1/D = 0: every term
     // carries a power of 1/D, and D̂ = 0 keeps the brackets finite.
     let inv = if d2 <= cutoff2 { 1.0 / d2.sqrt() } else { 0.0 };
+    let sin = sin * switch.at(d2 * inv);
     let h = [dx * inv, dy * inv, dz * inv];
     let dot = |u: [f64; 3], v: [f64; 3]| u[0].mul_add(v[0], u[1].mul_add(v[1], u[2] * v[2]));
     let b = [bx, by, bz];
@@ -63,7 +65,7 @@ fn row_with<const IK: bool>(
 ) -> (Vector3<f64>, Vector3<f64>) {
     let at = [slots.x[k], slots.y[k], slots.z[k]];
     let n = [slots.nx[k], slots.ny[k], slots.nz[k]];
-    let (a, b) = (list.far_start[k] as usize, list.far_start[k + 1] as usize);
+    let (partners, weights) = list.far_row(k);
     let mut acc = [[0.0; LANES]; 7];
     let fields = [
         &slots.x[..],
@@ -73,9 +75,9 @@ fn row_with<const IK: bool>(
         &slots.ny[..],
         &slots.nz[..],
     ];
-    for (idx, w) in list.far_partner[a..b]
+    for (idx, w) in partners
         .chunks_exact(LANES)
-        .zip(list.far_weight[a..b].chunks_exact(LANES))
+        .zip(weights.chunks_exact(LANES))
     {
         // The block's partners, gathered field by field.
         let mut p = [[0.0; LANES]; 7];
@@ -94,6 +96,7 @@ fn row_with<const IK: bool>(
                 &n,
                 pre,
                 sys.cutoff2,
+                sys.switch,
                 std::array::from_fn(|f| p[f][l]),
                 std::array::from_fn(|m| acc[m][l]),
             );

@@ -3,13 +3,17 @@
 //! every right-hand side, and the steric forces and the contact guard through their near rows.
 
 use super::{
-    list_rows, vec3, AveragedSystem, Problem, Soa, DEFAULT_SKIN_OF_CUTOFF, LIST_SWIMMERS,
+    list_rows, pair_weight, AveragedSystem, Problem, Soa, DEFAULT_SKIN_OF_CUTOFF, LIST_SWIMMERS,
     PARALLEL_SWIMMERS, STATE_PER_SWIMMER,
 };
 use crate::engine::contacts::Steric;
 use crate::engine::neighbours::{ListSpec, NeighbourList};
 use nalgebra::Vector3;
 use rayon::prelude::*;
+
+/// Above this share of swimmers leaving their lists at once, the whole list is built anew
+/// instead of relisting them one by one.
+pub const MAX_RELISTED_FRACTION: f64 = 0.1;
 
 /// The list and the arrays in its slot order.
 #[derive(Debug, Clone, Default)]
@@ -28,6 +32,11 @@ impl Listed {
     /// Lists built so far.
     pub(super) fn builds(&self) -> u64 {
         self.builds
+    }
+
+    /// Swimmers relisted so far (in the list in use).
+    pub(super) fn relists(&self) -> u64 {
+        self.list.as_ref().map_or(0, |l| l.relists)
     }
 }
 
@@ -64,33 +73,60 @@ impl AveragedSystem {
         }
     }
 
-    /// After `fill`: a list valid for the current centres (rebuilt when a centre has moved half
-    /// the skin since its build), and its slot arrays filled from the current state.
+    /// After `fill`: a list valid for the current centres (swimmers that moved half the skin
+    /// from their references relisted, or everyone rebuilt when many did or the spec changed),
+    /// and its slot arrays filled from the current state.
     pub(super) fn update_list(&mut self) {
         let spec = self.list_spec();
         let soa = &self.soa;
-        let valid = self
-            .listed
-            .list
-            .as_ref()
-            .is_some_and(|l| l.spec() == spec && l.is_valid_for(&soa.x, &soa.y, &soa.z));
-        if !valid {
-            let weight = |i: usize, j: usize| self.pair_sin(i, j);
-            let list = NeighbourList::build(
-                &soa.x,
-                &soa.y,
-                &soa.z,
-                self.periodic.as_ref(),
-                spec,
-                &weight,
-            );
-            self.listed.list = Some(list);
-            self.listed.builds += 1;
+        let moved = match &self.listed.list {
+            Some(l) if l.spec() == spec => Some(l.moved(&soa.x, &soa.y, &soa.z)),
+            _ => None,
+        };
+        self.relist(moved);
+        self.refill_slots();
+    }
+
+    /// Relist the swimmers `moved` (at their centres in the arrays), or rebuild the whole list
+    /// when `None` or when more than [`MAX_RELISTED_FRACTION`] of the swimmers moved. Returns
+    /// whether the slot arrays need refilling (new slots).
+    pub(super) fn relist(&mut self, moved: Option<Vec<usize>>) -> bool {
+        let (sin, cos, skip) = (&self.sin_phi, &self.cos_phi, self.skip_zero_phase);
+        let weight = |i: usize, j: usize| pair_weight(sin, cos, skip, i, j);
+        let soa = &self.soa;
+        let n = self.coef.len();
+        match (moved, &mut self.listed.list) {
+            (Some(m), Some(list)) if (m.len() as f64) <= MAX_RELISTED_FRACTION * n as f64 => {
+                let mut grown = false;
+                for s in m {
+                    grown |= list.relist(s, [soa.x[s], soa.y[s], soa.z[s]], &weight);
+                }
+                grown
+            }
+            _ => {
+                let spec = self.list_spec();
+                let soa = &self.soa;
+                let list = NeighbourList::build(
+                    &soa.x,
+                    &soa.y,
+                    &soa.z,
+                    self.periodic.as_ref(),
+                    spec,
+                    &weight,
+                );
+                self.listed.list = Some(list);
+                self.listed.builds += 1;
+                true
+            }
         }
+    }
+
+    /// The slot arrays from the arrays in state order.
+    pub(super) fn refill_slots(&mut self) {
         let Some(list) = &self.listed.list else {
             return;
         };
-        let slots = &mut self.listed.slots;
+        let (soa, slots) = (&self.soa, &mut self.listed.slots);
         list.fill_positions(
             [&soa.x, &soa.y, &soa.z],
             [&mut slots.x, &mut slots.y, &mut slots.z],
@@ -102,6 +138,39 @@ impl AveragedSystem {
         ] {
             list.fill_values(|s| from[s], 0.0, to);
         }
+    }
+
+    /// The neighbour list in use, if any.
+    pub(super) fn listed_list(&self) -> Option<&NeighbourList> {
+        self.listed.list.as_ref()
+    }
+
+    /// The neighbour list and its slot arrays (lists in use, built).
+    pub(super) fn listed_parts(&self) -> (&NeighbourList, &Soa) {
+        let list = self
+            .listed
+            .list
+            .as_ref()
+            .expect("a neighbour list is built");
+        (list, &self.listed.slots)
+    }
+
+    /// The steric forces on swimmer `s`'s spheres from its near partners (lists in use).
+    pub(super) fn steric_of(&self, st: Steric, s: usize) -> [Vector3<f64>; 2] {
+        let (list, slots) = self.listed_parts();
+        self.slot_steric(st, list, slots, list.slot_of[s] as usize)
+    }
+
+    /// Swimmer `s`'s slot entries (its slot and ghosts) from its centre `c` and orientation `n`.
+    pub(super) fn refresh_slots(&mut self, s: usize, c: [f64; 3], n: [f64; 3]) {
+        let Some(list) = &self.listed.list else {
+            return;
+        };
+        let slots = &mut self.listed.slots;
+        list.set_position(s, c, [&mut slots.x, &mut slots.y, &mut slots.z]);
+        list.set_value(s, n[0], &mut slots.nx);
+        list.set_value(s, n[1], &mut slots.ny);
+        list.set_value(s, n[2], &mut slots.nz);
     }
 
     /// Swimmer `s`'s sphere centres if it sat in slot `k` (length ℓ, as [`AveragedSystem::fill`]).
@@ -121,21 +190,7 @@ impl AveragedSystem {
         let slots = &self.listed.slots;
         let mut forces = std::mem::take(&mut self.listed.forces);
         forces.resize(list.len(), [Vector3::zeros(); 2]);
-        let one = |k: usize, f: &mut [Vector3<f64>; 2]| {
-            let s = list.order[k] as usize;
-            let a = self.slot_spheres(slots, k, s);
-            let ra = [self.radii[2 * s], self.radii[2 * s + 1]];
-            *f = [Vector3::zeros(); 2];
-            let (from, to) = (list.near_start[k] as usize, list.near_start[k + 1] as usize);
-            for &p in &list.near_partner[from..to] {
-                let r = list.swimmer_of(p as usize);
-                let b = self.slot_spheres(slots, p as usize, r);
-                let rb = [self.radii[2 * r], self.radii[2 * r + 1]];
-                let df = st.swimmer_pair_forces(a, ra, b, rb);
-                f[0] += df[0];
-                f[1] += df[1];
-            }
-        };
+        let one = |k: usize, f: &mut [Vector3<f64>; 2]| *f = self.slot_steric(st, list, slots, k);
         if list.len() >= PARALLEL_SWIMMERS {
             forces
                 .par_iter_mut()
@@ -152,6 +207,29 @@ impl AveragedSystem {
         self.listed.forces = forces;
     }
 
+    /// The steric forces on the spheres of the swimmer in slot `k` from its near partners.
+    fn slot_steric(
+        &self,
+        st: Steric,
+        list: &NeighbourList,
+        slots: &Soa,
+        k: usize,
+    ) -> [Vector3<f64>; 2] {
+        let s = list.order[k] as usize;
+        let a = self.slot_spheres(slots, k, s);
+        let ra = [self.radii[2 * s], self.radii[2 * s + 1]];
+        let mut f = [Vector3::zeros(); 2];
+        for &p in list.near_row(k) {
+            let r = list.swimmer_of(p as usize);
+            let b = self.slot_spheres(slots, p as usize, r);
+            let rb = [self.radii[2 * r], self.radii[2 * r + 1]];
+            let df = st.swimmer_pair_forces(a, ra, b, rb);
+            f[0] += df[0];
+            f[1] += df[1];
+        }
+        f
+    }
+
     /// Fill `dy` from the far rows (and the steric rates), slot by slot in parallel.
     pub(super) fn rows_by_list(&mut self, y: &[f64], dy: &mut [f64]) {
         let Some(list) = &self.listed.list else {
@@ -161,17 +239,8 @@ impl AveragedSystem {
         let mut rates = std::mem::take(&mut self.listed.rates);
         rates.resize(list.len(), [0.0; 6]);
         let one = |k: usize, out: &mut [f64; 6]| {
-            let s = list.order[k] as usize;
-            let (mut v, t) = list_rows::row(self, list, slots, k);
-            let n = vec3(y, STATE_PER_SWIMMER * s + 3);
-            let mut dn = -(t - n * n.dot(&t));
-            if self.contacts.steric.is_some() {
-                let (vs, ns) = self.steric_rates(s);
-                v += vs;
-                dn += ns;
-            }
-            out[..3].copy_from_slice(v.as_slice());
-            out[3..].copy_from_slice(dn.as_slice());
+            let (v, t) = list_rows::row(self, list, slots, k);
+            self.finish_rates(list.order[k] as usize, y, v, t, out);
         };
         if list.len() >= PARALLEL_SWIMMERS {
             rates
@@ -191,6 +260,42 @@ impl AveragedSystem {
         self.listed.rates = rates;
     }
 
+    /// The near pairs (s < r) of the list, each with the lattice vector that brings r's centre
+    /// to the image s meets, of the swimmers `bodies` (sorted; all when `None`); `None` without a
+    /// list.
+    pub(super) fn near_pairs(
+        &self,
+        bodies: Option<&[usize]>,
+    ) -> Option<Vec<(usize, usize, Vector3<f64>)>> {
+        if !self.uses_lists() {
+            return None;
+        }
+        let list = self.listed.list.as_ref()?;
+        let (soa, slots) = (&self.soa, &self.listed.slots);
+        let at = |v: &Soa, i: usize| Vector3::new(v.x[i], v.y[i], v.z[i]);
+        let mut out = Vec::new();
+        let row = |k: usize, out: &mut Vec<_>| {
+            let s = list.order[k] as usize;
+            for &p in list.near_row(k) {
+                let r = list.swimmer_of(p as usize);
+                let shift = (at(slots, p as usize) - at(slots, k)) - (at(soa, r) - at(soa, s));
+                if r > s {
+                    out.push((s, r, shift));
+                } else if bodies.is_some_and(|b| b.binary_search(&r).is_err()) {
+                    // Seen from r, which is not among the bodies: its own row is not read.
+                    out.push((r, s, -shift));
+                }
+            }
+        };
+        match bodies {
+            None => (0..list.len()).for_each(|k| row(k, &mut out)),
+            Some(b) => b
+                .iter()
+                .for_each(|&s| row(list.slot_of[s] as usize, &mut out)),
+        }
+        Some(out)
+    }
+
     /// The contact guard through the near rows (after `update_list`): two interacting swimmers
     /// at the same centre (the pair of smallest indices), else the overlap of smallest gap
     /// (then smallest sphere indices), as the all-pairs guard names them.
@@ -200,8 +305,7 @@ impl AveragedSystem {
         };
         let (soa, slots) = (&self.soa, &self.listed.slots);
         let partners = |k: usize| {
-            let (from, to) = (list.near_start[k] as usize, list.near_start[k + 1] as usize);
-            list.near_partner[from..to]
+            list.near_row(k)
                 .iter()
                 .map(|&p| (p as usize, list.swimmer_of(p as usize)))
         };

@@ -15,12 +15,16 @@
 //! lists in `list_rows`, and the lists' upkeep, steric forces and contact guard in `listed`.
 //! tests/averaged_model.rs compares every shortcut with the general 3D sum.
 
+mod implicit;
 mod lanes;
 mod list_rows;
 mod listed;
+mod partitioned;
+
+pub use implicit::{CONTACT_MARGIN_OF_RANGE, DISPLACEMENT_FLOOR, MAX_CLUSTER_SWIMMERS};
 
 use super::contacts::Contacts;
-use super::integrators::{Noise, OdeSystem, Problem};
+use super::integrators::{GroupJacobian, Noise, OdeSystem, Partitioned, Problem};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, Coefficients, STATE_PER_SWIMMER};
 use super::pairs::SoaSpheres;
@@ -115,6 +119,53 @@ pub(crate) fn pair_constants(d: &Dumbbell, set: Coefficients) -> [f64; 8] {
     [c.a_r, c.c_j, c.a_n, c.v0, c.w0, c.big_l, c.ell, c.phase]
 }
 
+/// The far-field cutoff's switch, as a fraction of the cutoff D_c: see [`CutoffSwitch`].
+pub const CUTOFF_SWITCH_WIDTH: f64 = 0.1;
+
+/// The far-field cutoff's switch: a pair's terms are weighed by S(D) = 1 below (1 − w)D_c, 0 from
+/// D_c on, and between them the smoothstep S = 1 − x⁴(35 − 84x + 70x² − 20x³),
+/// x = (D − (1 − w)D_c)/(w D_c), whose first three derivatives vanish at both ends (w =
+/// [`CUTOFF_SWITCH_WIDTH`]). The rates are then three times continuously differentiable as
+/// pairs cross the cutoff: the integrators keep their orders (RK4's needs that much) and their
+/// error estimates stay meaningful, where a pair leaving at once would jump the rates and stall
+/// every adaptive step that straddles the crossing.
+#[derive(Debug, Clone, Copy)]
+pub struct CutoffSwitch {
+    /// (1 − w) D_c (m); 0 without a cutoff.
+    inner: f64,
+    /// 1/(w D_c) (1/m); 0 without a cutoff (every pair weighs 1).
+    inv_width: f64,
+}
+
+impl CutoffSwitch {
+    fn new(cutoff: Option<f64>) -> Self {
+        match cutoff {
+            Some(c) if c.is_finite() => CutoffSwitch {
+                inner: (1.0 - CUTOFF_SWITCH_WIDTH) * c,
+                inv_width: 1.0 / (CUTOFF_SWITCH_WIDTH * c),
+            },
+            _ => CutoffSwitch {
+                inner: 0.0,
+                inv_width: 0.0,
+            },
+        }
+    }
+
+    /// S(D) for a pair at distance `d` (m, finite).
+    #[inline(always)]
+    pub fn at(&self, d: f64) -> f64 {
+        let x = ((d - self.inner) * self.inv_width).clamp(0.0, 1.0);
+        let x2 = x * x;
+        let p = x.mul_add(x.mul_add((-20.0f64).mul_add(x, 70.0), -84.0), 35.0);
+        (-(x2 * x2)).mul_add(p, 1.0)
+    }
+
+    /// Where the switch starts, (1 − w) D_c (m): pairs beyond weigh less than 1.
+    pub fn inner(&self) -> f64 {
+        self.inner
+    }
+}
+
 /// From this many swimmers on, the rows of the pair sums run in parallel (a row costs ~S × 60 ns,
 /// so 256 rows are ≳ 4 ms of work against rayon's few-µs dispatch).
 pub const PARALLEL_SWIMMERS: usize = 256;
@@ -138,12 +189,13 @@ struct Soa {
 /// from [`PARALLEL_SWIMMERS`] on, and a row's sum does not depend on the thread count.
 ///
 /// Far-field cutoff ([`AveragedSystem::set_cutoff`], off by default): pairs further apart than D_c
-/// are left out. Each term of a pair at distance D ≥ D_c is bounded with |sin| ≤ 1 and every
-/// bracket bounded term by term (|N·D̂|, |q| ≤ 1):
+/// are left out, and pairs beyond D_s = (1 − w)D_c weighed down smoothly ([`CutoffSwitch`]). Each
+/// term of a pair at distance D ≥ D_s is bounded with |sin| ≤ 1 and every bracket bounded term by
+/// term (|N·D̂|, |q| ≤ 1): what the cutoff takes from such a pair is at most
 /// |ΔdR_H/dt| ≤ (9/64) v0 [28 |A_R| (Λ/ℓ) ξ³ + 84 c_J ξ⁴] and
-/// |ΔdN/dt| ≤ w0 (Λ/ℓ) [(15/64)·148 ξ⁵ + (9/32)·68 |A_N| ξ⁴], ξ = ℓ/D_c, per left-out pair
-/// ([`AveragedSystem::far_pair_bound`]); a swimmer's error is at most the number of pairs it
-/// leaves out times that. The D⁻³ term of asymmetric swimmers decays slowest: in a uniform
+/// |ΔdN/dt| ≤ w0 (Λ/ℓ) [(15/64)·148 ξ⁵ + (9/32)·68 |A_N| ξ⁴], ξ = ℓ/D_s
+/// ([`AveragedSystem::far_pair_bound`] at D_s); a swimmer's error is at most the number of its
+/// pairs beyond D_s times that. The D⁻³ term of asymmetric swimmers decays slowest: in a uniform
 /// suspension the number of pairs in a shell grows as D², so the cutoff suits symmetric swimmers
 /// (D⁻⁴ and faster) or a dilute scene best.
 #[derive(Debug, Clone)]
@@ -156,6 +208,8 @@ pub struct AveragedSystem {
     skip_zero_phase: bool,
     /// D_c² (m²); infinite without a cutoff.
     cutoff2: f64,
+    /// The cutoff's switch (every pair weighs 1 without a cutoff).
+    switch: CutoffSwitch,
     /// The common axis when every centre and orientation lies on one line.
     axis: Option<Vector3<f64>>,
     scale_r: Vec<f64>,
@@ -242,6 +296,7 @@ impl AveragedSystem {
             soa,
             skip_zero_phase: shortcuts.skip_zero_phase_pairs,
             cutoff2: f64::INFINITY,
+            switch: CutoffSwitch::new(None),
             axis: None,
             skip_symmetric: shortcuts.skip_symmetric_terms,
             weights: swimmers.iter().map(|d| (d.w1(), d.w2())).collect(),
@@ -317,12 +372,23 @@ impl AveragedSystem {
 
     /// The steric rates (dR_H/dt, dN/dt) of swimmer σ from the forces on its spheres.
     fn steric_rates(&self, s: usize) -> (Vector3<f64>, Vector3<f64>) {
-        let (f1, f2) = (self.steric_f[2 * s], self.steric_f[2 * s + 1]);
+        let n = Vector3::new(self.soa.nx[s], self.soa.ny[s], self.soa.nz[s]);
+        self.steric_rates_of(s, n, [self.steric_f[2 * s], self.steric_f[2 * s + 1]])
+    }
+
+    /// The rates (dR_H/dt, dN/dt) of swimmer σ with orientation `n` from forces `f` on its spheres:
+    /// a free-draining rigid dumbbell (see [`AveragedSystem::set_contacts`]).
+    fn steric_rates_of(
+        &self,
+        s: usize,
+        n: Vector3<f64>,
+        f: [Vector3<f64>; 2],
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let [f1, f2] = f;
         let (a1, a2) = (self.radii[2 * s], self.radii[2 * s + 1]);
         let v = (f1 + f2) * self_mobility(self.mu, a1 + a2);
         let rel =
             (f2 * self_mobility(self.mu, a2) - f1 * self_mobility(self.mu, a1)) / self.coef[s].ell;
-        let n = Vector3::new(self.soa.nx[s], self.soa.ny[s], self.soa.nz[s]);
         (v, rel - n * n.dot(&rel))
     }
 
@@ -349,9 +415,15 @@ impl AveragedSystem {
         self.listed.builds()
     }
 
+    /// How many swimmers the neighbour list in use relisted alone.
+    pub fn list_relists(&self) -> u64 {
+        self.listed.relists()
+    }
+
     /// Leave out pairs further apart than `cutoff` (m); `None` keeps every pair.
     pub fn set_cutoff(&mut self, cutoff: Option<f64>) {
         self.cutoff2 = cutoff.map_or(f64::INFINITY, |c| c * c);
+        self.switch = CutoffSwitch::new(cutoff);
     }
 
     /// Bounds on what one pair at distance `distance` (m) adds to swimmer σ's dR_H/dt (m/s) and
@@ -412,8 +484,7 @@ impl AveragedSystem {
     /// sin(φσ − φρ) if the pair interacts (it is not skipped as a zero-phase pair).
     #[inline]
     fn pair_sin(&self, s: usize, r: usize) -> Option<f64> {
-        let sin = self.sin_phi[s] * self.cos_phi[r] - self.cos_phi[s] * self.sin_phi[r];
-        (s != r && (sin.abs() > SIN_ZERO || !self.skip_zero_phase)).then_some(sin)
+        pair_weight(&self.sin_phi, &self.cos_phi, self.skip_zero_phase, s, r)
     }
 
     /// dR_H/dt of swimmer σ and the torque-like sum T (dN/dt = −(1 − NNᵀ) T), from the arrays.
@@ -440,6 +511,7 @@ impl AveragedSystem {
                 return;
             }
             let dist = d2.sqrt();
+            let sin = sin * self.switch.at(dist);
             let dh = dvec / dist;
             let nr = Vector3::new(src.nx[k], src.ny[k], src.nz[k]);
             let (ss, rr, q) = (dh.dot(&ns), dh.dot(&nr), ns.dot(&nr));
@@ -498,6 +570,7 @@ impl AveragedSystem {
             if d * d > self.cutoff2 {
                 continue;
             }
+            let sin = sin * self.switch.at(d.abs());
             let xi = c.ell / d.abs();
             v += 9.0 / 16.0
                 * c.v0
@@ -507,36 +580,56 @@ impl AveragedSystem {
         v
     }
 
+    /// Whether the all-pairs rows run in vector lanes.
+    fn vector_rows(&self) -> bool {
+        self.axis.is_none()
+            && self.periodic.is_none()
+            && self.lanes.unwrap_or(self.coef.len() >= LANE_SWIMMERS)
+    }
+
+    /// Swimmer σ's rates without neighbour lists, from the arrays filled from state `y`: the 1D
+    /// reduction, or the all-pairs row (in vector lanes when `vector`), plus the steric rates.
+    fn row_rates(&self, s: usize, y: &[f64], vector: bool, out: &mut [f64]) {
+        if let Some(axis) = self.axis {
+            let v = self.row_aligned(s) * axis;
+            out[..3].copy_from_slice(v.as_slice());
+            out[3..6].fill(0.0);
+            return;
+        }
+        let (v, t) = if vector {
+            lanes::row(self, s)
+        } else {
+            self.row(s)
+        };
+        self.finish_rates(s, y, v, t, out);
+    }
+
+    /// The rates of swimmer σ from its far-field sums (dR_H/dt `v`, torque-like `t`): dN/dt =
+    /// −(1 − NNᵀ)T, plus the steric rates.
+    fn finish_rates(
+        &self,
+        s: usize,
+        y: &[f64],
+        mut v: Vector3<f64>,
+        t: Vector3<f64>,
+        out: &mut [f64],
+    ) {
+        let n = vec3(y, STATE_PER_SWIMMER * s + 3);
+        let mut dn = -(t - n * n.dot(&t));
+        if self.contacts.steric.is_some() {
+            let (vs, ns) = self.steric_rates(s);
+            v += vs;
+            dn += ns;
+        }
+        out[..3].copy_from_slice(v.as_slice());
+        out[3..6].copy_from_slice(dn.as_slice());
+    }
+
     /// Fill `dy` row by row (in parallel for large scenes).
     fn rows_into(&self, y: &[f64], dy: &mut [f64]) {
-        let count = self.coef.len();
-        let parallel = count >= PARALLEL_SWIMMERS;
-        let vector = self.axis.is_none()
-            && self.periodic.is_none()
-            && self.lanes.unwrap_or(count >= LANE_SWIMMERS);
-        let one = |s: usize, out: &mut [f64]| {
-            if let Some(axis) = self.axis {
-                let v = self.row_aligned(s) * axis;
-                out[..3].copy_from_slice(v.as_slice());
-                out[3..6].fill(0.0);
-                return;
-            }
-            let (mut v, t) = if vector {
-                lanes::row(self, s)
-            } else {
-                self.row(s)
-            };
-            let n = vec3(y, STATE_PER_SWIMMER * s + 3);
-            let mut dn = -(t - n * n.dot(&t));
-            if self.contacts.steric.is_some() {
-                let (vs, ns) = self.steric_rates(s);
-                v += vs;
-                dn += ns;
-            }
-            out[..3].copy_from_slice(v.as_slice());
-            out[3..6].copy_from_slice(dn.as_slice());
-        };
-        if parallel {
+        let vector = self.vector_rows();
+        let one = |s: usize, out: &mut [f64]| self.row_rates(s, y, vector, out);
+        if self.coef.len() >= PARALLEL_SWIMMERS {
             dy.par_chunks_mut(STATE_PER_SWIMMER)
                 .enumerate()
                 .for_each(|(s, out)| one(s, out));
@@ -585,6 +678,32 @@ impl OdeSystem for AveragedSystem {
             );
         }
         self.rows_into(y, dy);
+    }
+
+    fn autonomous(&self) -> bool {
+        true
+    }
+
+    fn stiff_groups(&mut self, _t: f64, y: &[f64]) -> GroupJacobian {
+        self.contact_jacobian(y)
+    }
+
+    fn step_error_norm(
+        &self,
+        y: &[f64],
+        y_new: &[f64],
+        err: &[f64],
+        h: f64,
+        f0: &[f64],
+        tol: f64,
+    ) -> f64 {
+        let mut e = vec![0.0; self.coef.len()];
+        self.swimmer_errors(y, y_new, err, h, f0, tol, None, &mut None, &mut e);
+        (e.iter().map(|e| e * e).sum::<f64>() / e.len().max(1) as f64).sqrt()
+    }
+
+    fn as_partitioned(&mut self) -> Option<&mut dyn Partitioned> {
+        Some(self)
     }
 
     /// Centres against the closest pair's per-period drift scale (as in the microscopic model),
@@ -704,6 +823,14 @@ impl OdeSystem for AveragedSystem {
             set_vec3(y, i, &n);
         }
     }
+}
+
+/// sin(φσ − φρ) from the phases' sines and cosines if the pair interacts: not the same swimmer,
+/// and not a zero phase difference when `skip_zero` (the neighbour lists' pair weight).
+#[inline]
+fn pair_weight(sin: &[f64], cos: &[f64], skip_zero: bool, s: usize, r: usize) -> Option<f64> {
+    let v = sin[s] * cos[r] - cos[s] * sin[r];
+    (s != r && (v.abs() > SIN_ZERO || !skip_zero)).then_some(v)
 }
 
 /// The guard's error for swimmers `s` and `r` at the same centre.

@@ -15,6 +15,7 @@ mod rosenbrock;
 mod sde;
 mod spec;
 mod stroboscopic;
+mod suspension;
 mod system;
 
 pub use dopri5::Dopri5;
@@ -27,7 +28,8 @@ pub use rosenbrock::Rosenbrock;
 pub use sde::Platen;
 pub use spec::{Direct, IntegratorSpec, Method, METHODS};
 pub use stroboscopic::{Stroboscopic, MIN_MACRO};
+pub use suspension::Suspension;
 pub use system::{
-    require_resolvable, uniform_steps, Interrupt, Noise, OdeSystem, Problem, Stats, StepFailure,
-    Stepper, MIN_RELATIVE_INTERVAL,
+    require_resolvable, uniform_steps, GroupJacobian, Interrupt, Noise, OdeSystem, Partitioned,
+    Problem, Stats, StepFailure, Stepper, MIN_RELATIVE_INTERVAL,
 };

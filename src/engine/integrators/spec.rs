@@ -51,6 +51,13 @@ pub enum IntegratorSpec {
         /// Tolerance relative to the drift.
         tol: f64,
     },
+    /// ROS34PW2 implicit in the steric contacts alone, with each swimmer's error held to `tol` of
+    /// its own displacement over the step (see [`super::Suspension`]): the averaged model's
+    /// method for suspensions.
+    Suspension {
+        /// Tolerance relative to each swimmer's displacement over a step.
+        tol: f64,
+    },
 }
 
 /// A direct method: stroboscopic averaging's inner integrator.
@@ -103,6 +110,9 @@ impl TryFrom<IntegratorSpec> for Direct {
             )),
             IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => Err(invalid!(
                 "stroboscopic averaging cannot sample itself; give a direct inner integrator such as rk4(dt) or dopri5(rtol)"
+            )),
+            IntegratorSpec::Suspension { .. } => Err(invalid!(
+                "suspension(tol) is the averaged model's method and stroboscopic averaging is for the spring and rigid models; give a direct inner integrator such as rk4(dt) or dopri5(rtol)"
             )),
         }
     }
@@ -164,6 +174,14 @@ const AUTO: Method = Method {
     make: IntegratorSpec::auto,
 };
 
+const SUSPENSION: Method = Method {
+    name: "suspension",
+    parameter: "tol",
+    parameter_about: "the tolerance relative to each swimmer's displacement over a step",
+    about: "for suspensions (averaged model): implicit in the steric contacts, each swimmer's error against its own displacement",
+    make: IntegratorSpec::suspension,
+};
+
 const PLATEN: Method = Method {
     name: "platen",
     parameter: "dt",
@@ -181,7 +199,16 @@ const ROSW: Method = Method {
 };
 
 /// Every method, in the order messages list them.
-pub const METHODS: &[Method] = &[EULER, RK4, DOPRI5, STROBOSCOPIC, AUTO, ROSW, PLATEN];
+pub const METHODS: &[Method] = &[
+    EULER,
+    RK4,
+    DOPRI5,
+    STROBOSCOPIC,
+    AUTO,
+    ROSW,
+    SUSPENSION,
+    PLATEN,
+];
 
 impl IntegratorSpec {
     /// The method's entry in [`METHODS`].
@@ -194,6 +221,7 @@ impl IntegratorSpec {
             IntegratorSpec::Platen { .. } => &PLATEN,
             IntegratorSpec::Stroboscopic { .. } => &STROBOSCOPIC,
             IntegratorSpec::Auto { .. } => &AUTO,
+            IntegratorSpec::Suspension { .. } => &SUSPENSION,
         }
     }
 
@@ -204,7 +232,9 @@ impl IntegratorSpec {
             | IntegratorSpec::Rk4 { dt }
             | IntegratorSpec::Platen { dt } => dt,
             IntegratorSpec::Dopri5 { rtol } | IntegratorSpec::Rosw { rtol } => rtol,
-            IntegratorSpec::Stroboscopic { tol, .. } | IntegratorSpec::Auto { tol } => tol,
+            IntegratorSpec::Stroboscopic { tol, .. }
+            | IntegratorSpec::Auto { tol }
+            | IntegratorSpec::Suspension { tol } => tol,
         }
     }
 
@@ -261,8 +291,13 @@ impl IntegratorSpec {
         check_drift_tol("auto", tol).map(|tol| IntegratorSpec::Auto { tol })
     }
 
-    /// A fresh stepper for a direct method; `None` for stroboscopic averaging, which the scene
-    /// builds (it needs the period and the model's time scales).
+    /// The suspension method, checked: 1e-10 ≤ tol < 1.
+    pub fn suspension(tol: f64) -> Result<Self> {
+        check_drift_tol("suspension", tol).map(|tol| IntegratorSpec::Suspension { tol })
+    }
+
+    /// A fresh stepper for a direct method; `None` for stroboscopic averaging and the suspension
+    /// method, which the scene builds (they need the period and the model's time scales).
     pub fn build(&self) -> Option<Box<dyn Stepper>> {
         Some(match *self {
             IntegratorSpec::Euler { dt } => Box::new(Euler::new(dt)),
@@ -270,7 +305,9 @@ impl IntegratorSpec {
             IntegratorSpec::Dopri5 { rtol } => Box::new(Dopri5::new(rtol)),
             IntegratorSpec::Rosw { rtol } => Box::new(Rosenbrock::new(rtol)),
             IntegratorSpec::Platen { dt } => Box::new(Platen::new(dt)),
-            IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => return None,
+            IntegratorSpec::Stroboscopic { .. }
+            | IntegratorSpec::Auto { .. }
+            | IntegratorSpec::Suspension { .. } => return None,
         })
     }
 }

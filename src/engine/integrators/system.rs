@@ -35,6 +35,41 @@ pub trait OdeSystem {
     /// The diagonal blocks of (an approximation to) ∂f/∂y at (t, y), row-major, one after another.
     /// The models put the stiff part there: each dumbbell's own spring, drag and hydrodynamics.
     fn jacobian_blocks(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) {}
+    /// Whether f does not depend on t (linearly implicit methods then skip ∂f/∂t).
+    fn autonomous(&self) -> bool {
+        false
+    }
+    /// The sparse stiff part of ∂f/∂y at (t, y) for linearly implicit methods that take one
+    /// (`suspension`): dense blocks on disjoint groups of state components (the swimmers of one
+    /// cluster in steric contact), zero elsewhere. None by default.
+    fn stiff_groups(&mut self, _t: f64, _y: &[f64]) -> GroupJacobian {
+        GroupJacobian::default()
+    }
+    /// The norm of an adaptive step's error estimate `err`, for a step from `y` to `y_new` of
+    /// size `h` whose rates at `y` were `f0`, at tolerance `tol`: ≤ 1 accepts the step. By
+    /// default the RMS of err/(tol·scale) with [`OdeSystem::error_scale`] at `y`.
+    fn step_error_norm(
+        &self,
+        y: &[f64],
+        _y_new: &[f64],
+        err: &[f64],
+        _h: f64,
+        _f0: &[f64],
+        tol: f64,
+    ) -> f64 {
+        let mut scale = vec![0.0; y.len()];
+        self.error_scale(y, &mut scale);
+        let sum: f64 = err
+            .iter()
+            .zip(&scale)
+            .map(|(e, s)| (e / (tol * s)).powi(2))
+            .sum();
+        (sum / y.len().max(1) as f64).sqrt()
+    }
+    /// The system as bodies that can be stepped apart (multirate methods); `None` by default.
+    fn as_partitioned(&mut self) -> Option<&mut dyn Partitioned> {
+        None
+    }
     /// Thermal noise: the Itô system dy = f dt + B(t, y) dW. `None` (the default): deterministic.
     fn noise(&self) -> Option<Noise> {
         None
@@ -60,6 +95,107 @@ pub trait OdeSystem {
             hint: "use euler(dt), Euler-Maruyama".into(),
             fixes: Vec::new(),
         })
+    }
+}
+
+/// A system of bodies (swimmers) with [`Partitioned::body_size`] state components each, that a
+/// multirate method steps body by body: some bodies take shorter steps than others, reading the
+/// states of the rest from an interpolation.
+pub trait Partitioned {
+    /// State components per body (the state is the bodies' blocks one after another).
+    fn body_size(&self) -> usize;
+    /// Each body's error of a step from `y` to `y_new` (embedded estimate `err`, step `h`, rates
+    /// `f0` at `y`), relative to `tol` (≤ 1: within tolerance), for `bodies` (all when `None`),
+    /// into `out` (one per body, indexed by body). `floor`: the motion scales below which a
+    /// body's own motion is not taken, per unit of step; computed over all bodies when `None` on
+    /// entry and left there.
+    #[allow(clippy::too_many_arguments)]
+    fn body_errors(
+        &self,
+        y: &[f64],
+        y_new: &[f64],
+        err: &[f64],
+        h: f64,
+        f0: &[f64],
+        tol: f64,
+        bodies: Option<&[usize]>,
+        floor: &mut Option<Vec<f64>>,
+        out: &mut [f64],
+    );
+    /// Into `out`, the bodies (not in `bodies`, sorted, each once) whose states the rates of
+    /// `bodies` read.
+    fn partners(&self, bodies: &[usize], out: &mut Vec<usize>);
+    /// The rates of `bodies` at state `y` into their blocks of `dy` (other blocks untouched), the
+    /// states of the bodies `changed` having changed since the last evaluation (the others as
+    /// then).
+    fn rhs_bodies(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        bodies: &[usize],
+        changed: &[usize],
+        dy: &mut [f64],
+    );
+    /// The stiff groups among `bodies` at `y`, or `None` when one of them would couple a body of
+    /// `bodies` to one outside (a contact forming with a body stepped apart).
+    fn stiff_groups_of(&mut self, t: f64, y: &[f64], bodies: &[usize]) -> Option<GroupJacobian>;
+}
+
+/// A block-sparse matrix: a dense square block on each of several disjoint groups of state
+/// components, zero elsewhere (J = Σ_g P_gᵀ J_g P_g).
+#[derive(Debug, Clone, Default)]
+pub struct GroupJacobian {
+    /// Each group: its state components and its block (row-major, components × components).
+    pub groups: Vec<(Vec<usize>, Vec<f64>)>,
+}
+
+impl GroupJacobian {
+    /// Whether it has no group (J = 0).
+    pub fn is_empty(&self) -> bool {
+        self.groups.is_empty()
+    }
+
+    /// `out` += J·v (only the groups' components change).
+    pub fn add_product(&self, v: &[f64], out: &mut [f64]) {
+        for (idx, block) in &self.groups {
+            let m = idx.len();
+            for (r, &i) in idx.iter().enumerate() {
+                let row = &block[r * m..(r + 1) * m];
+                out[i] += row.iter().zip(idx).map(|(a, &j)| a * v[j]).sum::<f64>();
+            }
+        }
+    }
+
+    /// The LU factors of I − c·J_g for every group.
+    pub fn factor_shifted(&self, c: f64) -> Vec<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> {
+        self.groups
+            .iter()
+            .map(|(idx, block)| {
+                let m = idx.len();
+                DMatrix::from_fn(m, m, |r, q| {
+                    f64::from(u8::from(r == q)) - c * block[r * m + q]
+                })
+                .lu()
+            })
+            .collect()
+    }
+
+    /// b ← (I − c·J)⁻¹ b with `lus` from [`GroupJacobian::factor_shifted`] (identity outside the
+    /// groups). A singular block leaves NaN in its components (the step is then rejected).
+    pub fn solve_shifted(
+        &self,
+        lus: &[nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>],
+        b: &mut [f64],
+    ) {
+        for ((idx, _), lu) in self.groups.iter().zip(lus) {
+            let mut x = nalgebra::DVector::from_iterator(idx.len(), idx.iter().map(|&i| b[i]));
+            if !lu.solve_mut(&mut x) {
+                x.fill(f64::NAN);
+            }
+            for (k, &i) in idx.iter().enumerate() {
+                b[i] = x[k];
+            }
+        }
     }
 }
 
@@ -114,6 +250,10 @@ pub struct Stats {
     /// Microscopic periods stroboscopic averaging integrated (samples, transients, remainders).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub micro_periods: u64,
+    /// Steps of bodies taken apart inside a multirate method's steps (`suspension`'s refined
+    /// swimmers; saved only when non-zero).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub refined_steps: u64,
     /// Steps taken with thermal noise; also the noise generator's counter, so that a run split in
     /// two, or saved and loaded between, draws the same noise (saved only when non-zero).
     #[serde(default, skip_serializing_if = "is_zero")]

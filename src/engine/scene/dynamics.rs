@@ -2,7 +2,7 @@
 //! the right-hand side ([`OdeSystem`]) of the chosen model that every run and query uses.
 
 use super::*;
-use crate::engine::integrators::{Stepper, Stroboscopic, MIN_MACRO};
+use crate::engine::integrators::{Stepper, Stroboscopic, Suspension, MIN_MACRO};
 
 impl Scene {
     /// Spring tension k0 (d − L) of swimmer `i` (N), or the constraint tension in the rigid-stroke
@@ -201,6 +201,16 @@ impl Scene {
         if let IntegratorSpec::Auto { tol } = spec {
             return self.stepper(self.auto_choice(tol)?.0);
         }
+        if let IntegratorSpec::Suspension { tol } = spec {
+            if self.model != Model::Averaged {
+                return Err(unsupported(
+                    format!("{spec} is the averaged model's method for suspensions: the {} model's springs or strokes have no steric-contact structure for it to use", self.model.name()),
+                    &[Setting::Model("averaged"), Setting::DefaultIntegrator],
+                ));
+            }
+            // The first step: one stroke period (the controller takes it from there).
+            return Ok(Box::new(Suspension::new(tol, self.shortest_period())));
+        }
         let IntegratorSpec::Stroboscopic { tol, inner } = spec else {
             return Err(invalid!("{spec} has no stepper"));
         };
@@ -297,6 +307,12 @@ impl Scene {
     /// that inner method directly); without one, the inner method directly. Springs so stiff
     /// that RK4 would take more than [`STIFF_STEPS_PER_PERIOD`] steps a period take rosw.
     pub fn auto_choice(&self, tol: f64) -> Result<(IntegratorSpec, String)> {
+        if self.is_suspension() {
+            return Ok((
+                IntegratorSpec::Suspension { tol },
+                "a suspension of the averaged model: each swimmer's error held to tol of its own displacement, steric contacts implicit, a few fast swimmers stepped apart".into(),
+            ));
+        }
         if self.model == Model::Averaged {
             let rtol = (tol * 1e-2).clamp(1e-13, DEFAULT_AVERAGED_RTOL);
             return Ok((
@@ -326,6 +342,11 @@ impl Scene {
                 let (chosen, why) = self.auto_choice(tol)?;
                 format!("{spec} runs {chosen}: {why}")
             }
+            IntegratorSpec::Suspension { .. } if self.integrator_is_default() => format!(
+                "{spec}: the {} model's default for a suspension (a box, a cutoff, steric repulsion or at least {} swimmers): each swimmer's error held to tol of its own displacement over a step, steric contacts implicit, a few fast swimmers (a contact, a close pair) stepped apart with steps of their own",
+                self.model.name(),
+                super::SUSPENSION_SWIMMERS
+            ),
             _ if self.integrator_is_default() => {
                 format!("{spec}: the {} model's default", self.model.name())
             }

@@ -79,6 +79,9 @@ impl Scene {
                 IntegratorSpec::stroboscopic_with(tol, inner).map(|_| ())?
             }
             Some(IntegratorSpec::Auto { tol }) => IntegratorSpec::auto(tol).map(|_| ())?,
+            Some(IntegratorSpec::Suspension { tol }) => {
+                IntegratorSpec::suspension(tol).map(|_| ())?
+            }
             None => {}
         }
         if let Some(st) = self.contacts.steric {

@@ -1,0 +1,713 @@
+//! `suspension(tol)`: ROS34PW2 (Rang & Angermann's Rosenbrock-W method of [`super::Rosenbrock`],
+//! order 3 with an embedded order 2, L-stable) made linearly implicit in the system's sparse stiff
+//! part alone ([`OdeSystem::stiff_groups`]: in a suspension the steric contacts, a few small
+//! clusters) and explicit in the rest, with the system's own error norm
+//! ([`OdeSystem::step_error_norm`]: each swimmer's error against its own displacement over the
+//! step).
+//!
+//! Why this method for suspensions: the far field moves a swimmer by ~1e-4ℓ a period and changes
+//! over hundreds of periods, while a steric contact relaxes at k/(6πμa) ~ 700/s, nine times a
+//! period. An explicit method is held to a step within its stability bound of that rate however
+//! slow the motion; a W-method keeps its order with any matrix in place of the Jacobian, so the
+//! contacts' own blocks (dense LU per cluster) remove that bound while everything else stays
+//! explicit and costs what an explicit stage costs. The error norm then lets the step follow the
+//! slow far field: a tolerance relative to each swimmer's displacement is what a suspension's
+//! structure is made of, where the default error scale of the averaged model (the closest pair's
+//! drift a period) would hold every swimmer to the slowest pair's precision.
+//!
+//! Individual steps. A close pair or a contact sliding over the kink of the repulsion's force
+//! law moves on a time scale of a period or less, while the rest of the suspension could take
+//! steps of many periods. A step is therefore taken for every swimmer and judged swimmer by
+//! swimmer ([`Partitioned::body_errors`]): when a few swimmers (at most [`MAX_REFINED_FRACTION`]
+//! of them, each within [`MAX_REFINED_ERROR`] of the tolerance) miss it and the rest meet it,
+//! the rest keep their step, and those few, with every swimmer in contact with them, are stepped
+//! again across the same interval by the same method with steps of their own (adaptive, at
+//! least [`MAX_SUBSTEPS`]), reading the other swimmers' states from the coarse step (quadratic
+//! through its start, its end and its starting rates; their error is within the tolerance).
+//! What the few did wrong in the coarse step reaches the rest only through the far field, at
+//! most MAX_REFINED_ERROR × tol of their own displacement at a distance of the cutoff; a contact
+//! forming between the few and the rest during the interval rejects the step instead. (Savcenco,
+//! Hundsdorfer & Verwer, BIT 47 (2007) 137, refine a coarse step the same way.)
+//!
+//! Stage equations (with k including the factor h; autonomous systems skip ∂f/∂t):
+//! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
+
+use super::rosenbrock::{A, B, B_EMBEDDED, G, GAMMA};
+use super::system::{
+    check_state, fit, stalled, step_too_small, tolerance_failure, GroupJacobian, OdeSystem,
+    Partitioned, Stats, StepFailure, Stepper,
+};
+
+const MAX_REJECTS: u32 = 60;
+
+/// The largest share of swimmers a step refines: more, and the whole step is taken again shorter.
+pub const MAX_REFINED_FRACTION: f64 = 0.05;
+
+/// The share of swimmers the step size controller aims to leave to refinement.
+pub const REFINED_TARGET_FRACTION: f64 = 0.01;
+
+/// Rounds of refining and stepping the ring again before a step is given up (each round adds the
+/// ring swimmers that missed the tolerance to the refined ones).
+pub const RING_ROUNDS: usize = 4;
+
+/// The most steps a refinement may take across one coarse step.
+pub const MAX_SUBSTEPS: u32 = 100_000;
+
+/// Adaptive ROS34PW2, implicit in the system's stiff groups, at tolerance `tol` of the system's
+/// step norm.
+#[derive(Debug, Clone)]
+pub struct Suspension {
+    tol: f64,
+    /// The first step when none is known (s).
+    first_step: f64,
+    h: Option<f64>,
+    k: [Vec<f64>; 4],
+    f: Vec<f64>,
+    f0: Vec<f64>,
+    ft: Vec<f64>,
+    tmp: Vec<f64>,
+    acc: Vec<f64>,
+    y_new: Vec<f64>,
+    err: Vec<f64>,
+    /// Scratch of the refinement (full length; only the refined swimmers' entries are used).
+    sub: Refinement,
+    /// Each group of refined swimmers' components and path across the coarse step: (time from
+    /// its start, their states).
+    paths: Vec<(Vec<usize>, Path)>,
+}
+
+/// A refined group's path across a coarse step: (time from its start, the group's states).
+type Path = Vec<(f64, Vec<f64>)>;
+
+/// Scratch of a refinement: the working state (the refined swimmers at their sub-step, the others
+/// interpolated), stages and rates.
+#[derive(Debug, Clone, Default)]
+struct Refinement {
+    yw: Vec<f64>,
+    y0: Vec<f64>,
+    k: [Vec<f64>; 4],
+    f: Vec<f64>,
+    f0: Vec<f64>,
+    acc: Vec<f64>,
+    y1: Vec<f64>,
+    err: Vec<f64>,
+    errors: Vec<f64>,
+}
+
+impl Suspension {
+    /// A stepper at tolerance `tol` whose first step is `first_step` (s).
+    pub fn new(tol: f64, first_step: f64) -> Self {
+        Suspension {
+            tol,
+            first_step,
+            h: None,
+            k: Default::default(),
+            f: Vec::new(),
+            f0: Vec::new(),
+            ft: Vec::new(),
+            tmp: Vec::new(),
+            acc: Vec::new(),
+            y_new: Vec::new(),
+            err: Vec::new(),
+            sub: Refinement::default(),
+            paths: Vec::new(),
+        }
+    }
+
+    /// One attempt with step h from (t, y): fills y_new and err.
+    #[allow(clippy::too_many_arguments)]
+    fn attempt(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        jac: &GroupJacobian,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        with_ft: bool,
+        stats: &mut Stats,
+    ) {
+        let n = y.len();
+        let lus = jac.factor_shifted(h * GAMMA);
+        for i in 0..4 {
+            // Stage argument, and h times the Γ-combination of the earlier stages.
+            for m in 0..n {
+                let mut ya = y[m];
+                let mut ga = 0.0;
+                for j in 0..i {
+                    ya += A[i][j] * self.k[j][m];
+                    ga += G[i][j] * self.k[j][m];
+                }
+                self.tmp[m] = ya;
+                self.acc[m] = h * ga;
+            }
+            if i == 0 {
+                self.f.copy_from_slice(&self.f0);
+            } else {
+                let c: f64 = A[i].iter().sum();
+                sys.rhs(t + c * h, &self.tmp, &mut self.f);
+                stats.rhs_evals += 1;
+            }
+            let gh = GAMMA + G[i].iter().sum::<f64>();
+            let k = &mut self.k[i];
+            for m in 0..n {
+                k[m] = h * self.f[m];
+            }
+            if with_ft {
+                for m in 0..n {
+                    k[m] += h * h * gh * self.ft[m];
+                }
+            }
+            jac.add_product(&self.acc, k);
+            jac.solve_shifted(&lus, k);
+        }
+        for m in 0..n {
+            let mut ynew = y[m];
+            let mut e = 0.0;
+            for i in 0..4 {
+                ynew += B[i] * self.k[i][m];
+                e += (B[i] - B_EMBEDDED[i]) * self.k[i][m];
+            }
+            self.y_new[m] = ynew;
+            self.err[m] = e;
+        }
+    }
+}
+
+impl Suspension {
+    /// The coarse step's error for the controller and whether it stands, after refining a few
+    /// swimmers where that lets it stand (see the module docs).
+    fn judge(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        jac: &GroupJacobian,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> (f64, bool) {
+        let norm = sys.step_error_norm(y, &self.y_new, &self.err, h, &self.f0, self.tol);
+        let whole = (norm, norm <= 1.0 && norm.is_finite());
+        let Some(p) = sys.as_partitioned() else {
+            return whole;
+        };
+        let bs = p.body_size();
+        let n = y.len() / bs.max(1);
+        let mut e = vec![0.0; n];
+        let mut floor = None;
+        p.body_errors(
+            y,
+            &self.y_new,
+            &self.err,
+            h,
+            &self.f0,
+            self.tol,
+            None,
+            &mut floor,
+            &mut e,
+        );
+        let fast: Vec<usize> = (0..n).filter(|&b| e[b].is_nan() || e[b] > 1.0).collect();
+        if fast.is_empty() {
+            return whole;
+        }
+        // The controller aims at a step that leaves REFINED_TARGET_FRACTION of the swimmers to
+        // refine: the error of the swimmer at that quantile.
+        let quantile = {
+            let mut sorted = e.clone();
+            sorted.sort_by(|a, b| a.total_cmp(b));
+            let at = ((1.0 - REFINED_TARGET_FRACTION) * n as f64).floor() as usize;
+            sorted[at.min(n - 1)]
+        };
+        let most = (MAX_REFINED_FRACTION * n as f64).floor() as usize;
+        if fast.len() > most {
+            return (quantile.max(1.0 + f64::EPSILON), false);
+        }
+        let floor = floor.unwrap_or_default();
+        // The fast swimmers with their contacts, refined; around them the swimmers that read
+        // them, stepped again; a ring swimmer that then misses the tolerance joins the refined.
+        let worst =
+            fast.iter().map(|&b| e[b]).fold(
+                0.0,
+                |m: f64, x| {
+                    if x.is_nan() {
+                        f64::INFINITY
+                    } else {
+                        m.max(x)
+                    }
+                },
+            );
+        let mut refined = closure(fast, jac, bs);
+        let mut ring = Vec::new();
+        let mut steps = 0;
+        let mut settled = false;
+        for _ in 0..RING_ROUNDS {
+            p.partners(&refined, &mut ring);
+            ring = closure(std::mem::take(&mut ring), jac, bs)
+                .into_iter()
+                .filter(|b| refined.binary_search(b).is_err())
+                .collect();
+            if refined.len() + ring.len() > most.max(1) * 8 {
+                // Stepping again a ring this large costs more than a shorter step for all: the
+                // step the fast swimmers need unrefined.
+                return (worst, false);
+            }
+            // Swimmers that read none of each other's states take their own steps.
+            self.prepare_sub(y, n);
+            self.paths.clear();
+            steps = 0;
+            for group in groups_of(p, &refined) {
+                let Some(taken) = self.refine(p, t, h, y, &group, &floor) else {
+                    return (f64::INFINITY, false);
+                };
+                steps += taken;
+            }
+            let missed = self.redo_ring(p, t, h, y, &refined, &ring, &floor);
+            if missed.is_empty() {
+                settled = true;
+                break;
+            }
+            refined = closure(refined.into_iter().chain(missed).collect(), jac, bs);
+        }
+        if !settled {
+            return (f64::INFINITY, false);
+        }
+        stats.refined_steps += steps;
+        let slow = {
+            let done =
+                |b: &usize| refined.binary_search(b).is_ok() || ring.binary_search(b).is_ok();
+            let rest: Vec<usize> = (0..n).filter(|b| !done(b)).collect();
+            let sum: f64 = rest.iter().map(|&b| e[b] * e[b]).sum();
+            (sum / rest.len().max(1) as f64).sqrt()
+        };
+        (slow.max(quantile), slow <= 1.0)
+    }
+
+    /// One W-method step of `bodies` from `t0` by `h` from their states in `sub.y0`, the other
+    /// states they read set by `read(yw, time)`: fills `sub.y1`, `sub.err`, `sub.f0` for their
+    /// components and returns the RMS of their errors, or `None` when a contact forms with a
+    /// swimmer outside.
+    #[allow(clippy::too_many_arguments)]
+    fn subset_step(
+        sub: &mut Refinement,
+        p: &mut dyn Partitioned,
+        tol: f64,
+        t0: f64,
+        h: f64,
+        bodies: &[usize],
+        changed: &[usize],
+        floor: &[f64],
+        read: &dyn Fn(&mut [f64], f64),
+    ) -> Option<f64> {
+        let bs = p.body_size();
+        let comps = || bodies.iter().flat_map(move |&b| b * bs..(b + 1) * bs);
+        for m in comps() {
+            sub.yw[m] = sub.y0[m];
+        }
+        read(&mut sub.yw, t0);
+        p.rhs_bodies(t0, &sub.yw, bodies, changed, &mut sub.f0);
+        let jac = p.stiff_groups_of(t0, &sub.yw, bodies)?;
+        let lus = jac.factor_shifted(h * GAMMA);
+        for i in 0..4 {
+            for m in comps() {
+                let mut ya = sub.y0[m];
+                let mut ga = 0.0;
+                for j in 0..i {
+                    ya += A[i][j] * sub.k[j][m];
+                    ga += G[i][j] * sub.k[j][m];
+                }
+                sub.yw[m] = ya;
+                sub.acc[m] = h * ga;
+            }
+            if i == 0 {
+                for m in comps() {
+                    sub.f[m] = sub.f0[m];
+                }
+            } else {
+                let c: f64 = A[i].iter().sum();
+                read(&mut sub.yw, t0 + c * h);
+                p.rhs_bodies(t0 + c * h, &sub.yw, bodies, changed, &mut sub.f);
+            }
+            let k = &mut sub.k[i];
+            for m in comps() {
+                k[m] = h * sub.f[m];
+            }
+            jac.add_product(&sub.acc, k);
+            jac.solve_shifted(&lus, k);
+        }
+        for m in comps() {
+            let mut y1 = sub.y0[m];
+            let mut e = 0.0;
+            for i in 0..4 {
+                y1 += B[i] * sub.k[i][m];
+                e += (B[i] - B_EMBEDDED[i]) * sub.k[i][m];
+            }
+            sub.y1[m] = y1;
+            sub.err[m] = e;
+        }
+        let mut fl = Some(floor.to_vec());
+        p.body_errors(
+            &sub.y0,
+            &sub.y1,
+            &sub.err,
+            h,
+            &sub.f0,
+            tol,
+            Some(bodies),
+            &mut fl,
+            &mut sub.errors,
+        );
+        let sum: f64 = bodies.iter().map(|&b| sub.errors[b] * sub.errors[b]).sum();
+        Some((sum / bodies.len().max(1) as f64).sqrt())
+    }
+
+    /// Scratch sized to the state `y`, with the working states at `y`.
+    fn prepare_sub(&mut self, y: &[f64], bodies: usize) {
+        let n = y.len();
+        let sub = &mut self.sub;
+        let [k1, k2, k3, k4] = &mut sub.k;
+        fit(
+            n,
+            &mut [
+                k1,
+                k2,
+                k3,
+                k4,
+                &mut sub.f,
+                &mut sub.f0,
+                &mut sub.acc,
+                &mut sub.y1,
+                &mut sub.err,
+            ],
+        );
+        sub.yw.clear();
+        sub.yw.extend_from_slice(y);
+        sub.y0.clear();
+        sub.y0.extend_from_slice(y);
+        sub.errors.resize(bodies, 0.0);
+    }
+
+    /// The states of components `read` at time `t0 + θh` from the coarse step from `y`: the
+    /// quadratic through y and y_new with slope f0 at the start.
+    fn coarse_at(
+        y: &[f64],
+        y_new: &[f64],
+        f0: &[f64],
+        h: f64,
+        read: &[usize],
+        yw: &mut [f64],
+        theta: f64,
+    ) {
+        for &i in read {
+            let slope = h * f0[i];
+            yw[i] = y[i] + theta * slope + theta * theta * (y_new[i] - y[i] - slope);
+        }
+    }
+
+    /// Step the swimmers `bodies` again from `t` to `t + h` by steps of their own, the others read
+    /// from the coarse step; their new states go into `y_new` and their path into `self.paths`.
+    /// The steps taken, or `None` when a contact forms with a swimmer outside or the steps
+    /// shrink to nothing.
+    fn refine(
+        &mut self,
+        p: &mut dyn Partitioned,
+        t: f64,
+        h: f64,
+        y: &[f64],
+        bodies: &[usize],
+        floor: &[f64],
+    ) -> Option<u64> {
+        let bs = p.body_size();
+        let mut partners = Vec::new();
+        p.partners(bodies, &mut partners);
+        let read: Vec<usize> = partners
+            .iter()
+            .flat_map(|&b| b * bs..(b + 1) * bs)
+            .collect();
+        let comps: Vec<usize> = bodies.iter().flat_map(|&b| b * bs..(b + 1) * bs).collect();
+        let mut changed: Vec<usize> = bodies.iter().chain(&partners).copied().collect();
+        changed.sort_unstable();
+        for &m in &comps {
+            self.sub.y0[m] = y[m];
+        }
+        let mut path = vec![(0.0, comps.iter().map(|&m| y[m]).collect::<Vec<f64>>())];
+        let (y_new, f0) = (&self.y_new, &self.f0);
+        let at =
+            |yw: &mut [f64], time: f64| Self::coarse_at(y, y_new, f0, h, &read, yw, (time - t) / h);
+        let mut tau = 0.0;
+        let mut hs = 0.5 * h;
+        let mut steps = 0u64;
+        let mut attempts = 0u32;
+        while tau < h {
+            attempts += 1;
+            if attempts > MAX_SUBSTEPS {
+                return None;
+            }
+            let span = h - tau;
+            let (h_try, last) = if hs >= span {
+                (span, true)
+            } else {
+                (hs, false)
+            };
+            let norm = Self::subset_step(
+                &mut self.sub,
+                p,
+                self.tol,
+                t + tau,
+                h_try,
+                bodies,
+                &changed,
+                floor,
+                &at,
+            );
+            let norm = norm?;
+            let fac = controller_factor(norm);
+            if norm <= 1.0 && norm.is_finite() {
+                for &m in &comps {
+                    self.sub.y0[m] = self.sub.y1[m];
+                }
+                tau = if last { h } else { tau + h_try };
+                path.push((tau, comps.iter().map(|&m| self.sub.y1[m]).collect()));
+                steps += 1;
+                if !(last && h_try < hs) {
+                    hs = h_try * fac;
+                }
+            } else {
+                hs = h_try * fac.min(0.9);
+                if step_too_small(hs, t + tau) || hs < 1e-12 * h {
+                    return None;
+                }
+            }
+        }
+        for &m in &comps {
+            self.y_new[m] = self.sub.y0[m];
+        }
+        self.paths.push((comps, path));
+        Some(steps)
+    }
+
+    /// Take the coarse step again for the swimmers `ring` that read the refined ones, now reading
+    /// those along their refined path (linear between their steps) and the rest from the coarse
+    /// step: what the refined swimmers' coarse states did to them is undone. The ring swimmers
+    /// that then miss the tolerance (all of them when a contact forms with a swimmer outside);
+    /// the others' new states go into `y_new`.
+    #[allow(clippy::too_many_arguments)]
+    fn redo_ring(
+        &mut self,
+        p: &mut dyn Partitioned,
+        t: f64,
+        h: f64,
+        y: &[f64],
+        refined: &[usize],
+        ring: &[usize],
+        floor: &[f64],
+    ) -> Vec<usize> {
+        if ring.is_empty() {
+            return Vec::new();
+        }
+        let bs = p.body_size();
+        let mut partners = Vec::new();
+        p.partners(ring, &mut partners);
+        let others: Vec<usize> = partners
+            .iter()
+            .filter(|b| refined.binary_search(b).is_err())
+            .flat_map(|&b| b * bs..(b + 1) * bs)
+            .collect();
+        let mut changed: Vec<usize> = ring.iter().chain(&partners).copied().collect();
+        changed.sort_unstable();
+        changed.dedup();
+        self.prepare_sub(y, y.len() / bs.max(1));
+        let (y_new, f0, paths) = (&self.y_new, &self.f0, &self.paths);
+        let at = |yw: &mut [f64], time: f64| {
+            Self::coarse_at(y, y_new, f0, h, &others, yw, (time - t) / h);
+            let tau = time - t;
+            for (comps, path) in paths {
+                let j = path
+                    .partition_point(|(s, _)| *s <= tau)
+                    .clamp(1, path.len() - 1);
+                let ((s0, a), (s1, b)) = (&path[j - 1], &path[j]);
+                let w = if s1 > s0 {
+                    ((tau - s0) / (s1 - s0)).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                for (q, &m) in comps.iter().enumerate() {
+                    yw[m] = a[q] + w * (b[q] - a[q]);
+                }
+            }
+        };
+        if Self::subset_step(&mut self.sub, p, self.tol, t, h, ring, &changed, floor, &at).is_none()
+        {
+            return ring.to_vec();
+        }
+        let missed: Vec<usize> = ring
+            .iter()
+            .copied()
+            .filter(|&b| self.sub.errors[b].is_nan() || self.sub.errors[b] > 1.0)
+            .collect();
+        if missed.is_empty() {
+            for &b in ring {
+                for m in b * bs..(b + 1) * bs {
+                    self.y_new[m] = self.sub.y1[m];
+                }
+            }
+        }
+        missed
+    }
+}
+
+/// The groups of `bodies` (sorted) that read one another's states, directly or through others of
+/// them: connected sets under [`Partitioned::partners`].
+fn groups_of(p: &dyn Partitioned, bodies: &[usize]) -> Vec<Vec<usize>> {
+    let mut parent: Vec<usize> = (0..bodies.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut partners = Vec::new();
+    for (i, &b) in bodies.iter().enumerate() {
+        p.partners(&[b], &mut partners);
+        for q in &partners {
+            if let Ok(j) = bodies.binary_search(q) {
+                let (a, c) = (root(&mut parent, i), root(&mut parent, j));
+                parent[a.max(c)] = a.min(c);
+            }
+        }
+    }
+    let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for (i, &b) in bodies.iter().enumerate() {
+        let r = root(&mut parent, i);
+        groups.entry(r).or_default().push(b);
+    }
+    groups.into_values().collect()
+}
+
+/// `bodies` with every body in a stiff group of `jac` with one of them, sorted.
+fn closure(mut bodies: Vec<usize>, jac: &GroupJacobian, bs: usize) -> Vec<usize> {
+    bodies.sort_unstable();
+    let mut added = Vec::new();
+    for (idx, _) in &jac.groups {
+        let members: Vec<usize> = idx.iter().map(|&i| i / bs).collect();
+        if members.iter().any(|m| bodies.binary_search(m).is_ok()) {
+            added.extend(members);
+        }
+    }
+    bodies.extend(added);
+    bodies.sort_unstable();
+    bodies.dedup();
+    bodies
+}
+
+/// The step-size factor after an attempt of error norm `err` (order 3 with an embedded 2): 0.9
+/// err^(−1/3), within 0.2 and 5.
+fn controller_factor(err: f64) -> f64 {
+    if err.is_finite() && err > 0.0 {
+        (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
+    } else if err == 0.0 {
+        5.0
+    } else {
+        0.2
+    }
+}
+
+impl Stepper for Suspension {
+    fn step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure> {
+        let n = y.len();
+        let [k1, k2, k3, k4] = &mut self.k;
+        fit(
+            n,
+            &mut [
+                k1,
+                k2,
+                k3,
+                k4,
+                &mut self.f,
+                &mut self.f0,
+                &mut self.ft,
+                &mut self.tmp,
+                &mut self.acc,
+                &mut self.y_new,
+                &mut self.err,
+            ],
+        );
+        sys.rhs(t, y, &mut self.f0);
+        stats.rhs_evals += 1;
+        let with_ft = !sys.autonomous();
+        if with_ft {
+            // ∂f/∂t by a forward difference (W-methods need only an approximation).
+            let dt_probe = 1e-7 * (t.abs() + self.h.unwrap_or(self.first_step)).max(1e-12);
+            sys.rhs(t + dt_probe, y, &mut self.ft);
+            stats.rhs_evals += 1;
+            for m in 0..n {
+                self.ft[m] = (self.ft[m] - self.f0[m]) / dt_probe;
+            }
+        }
+        let jac = sys.stiff_groups(t, y);
+        let mut h = self.h.unwrap_or(self.first_step);
+        let mut rejects = 0;
+        loop {
+            let span = t_end - t;
+            let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
+            self.attempt(sys, &jac, t, y, h_try, with_ft, stats);
+            let (err, accept) = self.judge(sys, &jac, t, y, h_try, stats);
+            let t_new = if last { t_end } else { t + h_try };
+            let guard = if accept {
+                sys.project(&mut self.y_new);
+                check_state(sys, t_new, &self.y_new)
+            } else {
+                Ok(())
+            };
+            let fac = controller_factor(err);
+            match (accept, guard) {
+                (true, Ok(())) => {
+                    y.copy_from_slice(&self.y_new);
+                    stats.steps += 1;
+                    let h_next = h_try * fac;
+                    // A step clipped to land on t_end says nothing about the natural step size.
+                    self.h = Some(if last && h_try < h {
+                        h.max(h_next)
+                    } else {
+                        h_next
+                    });
+                    return Ok(t_new);
+                }
+                (true, Err(failure)) => {
+                    stats.rejected += 1;
+                    stats.rejected_by_guard += 1;
+                    rejects += 1;
+                    if rejects >= MAX_REJECTS {
+                        return Err(failure);
+                    }
+                    h = h_try * 0.25;
+                    // Crawling towards the event the guard refuses: stop with it once the step no
+                    // longer advances the time.
+                    if step_too_small(h, t) {
+                        self.h = Some(h_try);
+                        return Err(failure);
+                    }
+                }
+                (false, _) => {
+                    stats.rejected += 1;
+                    rejects += 1;
+                    if rejects >= MAX_REJECTS {
+                        return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
+                    }
+                    h = h_try * fac.min(0.9);
+                    if step_too_small(h, t) {
+                        return Err(stalled(t_new, h));
+                    }
+                }
+            }
+        }
+    }
+
+    fn reset(&mut self) {}
+}

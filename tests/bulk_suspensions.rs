@@ -1,0 +1,279 @@
+//! Bulk suspensions of the averaged model (issue 32): neighbour lists against the all-pairs rows
+//! while swimmers move, cross faces and are relisted; the suspension stepper's order, its
+//! agreement with fine RK4, its contacts, guards, interrupts and save/load mid-run.
+
+use nalgebra::Vector3;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use swimlab::bench::suspension::{bulk_scene_apart, displacement_error};
+use swimlab::engine::averaged::AveragedSystem;
+use swimlab::engine::integrators::{IntegratorSpec, OdeSystem};
+use swimlab::engine::{Coefficients, Dumbbell, EngineError, Model, Observable, Scene, Simulation};
+
+fn asymmetric() -> Dumbbell {
+    Dumbbell {
+        a2: 0.5 * Dumbbell::default().a1,
+        ..Dumbbell::default()
+    }
+}
+
+/// The rates of `s`'s swimmers at state `y`, every pair found by the all-pairs rows.
+fn all_pairs_rates(s: &Scene, y: &[f64]) -> Vec<f64> {
+    let mut sys = system_of(s, y);
+    sys.set_neighbour_lists(Some(false));
+    let mut dy = vec![0.0; y.len()];
+    sys.rhs(0.0, y, &mut dy);
+    dy
+}
+
+fn system_of(s: &Scene, y: &[f64]) -> AveragedSystem {
+    let (_, base) = s.raw_state();
+    let mut sys = AveragedSystem::new(s.swimmers(), base, Coefficients::Paper, y);
+    sys.set_periodic(s.periodic().copied());
+    sys.set_cutoff(s.cutoff());
+    sys.set_contacts(s.contacts(), s.mu());
+    sys
+}
+
+/// Each 3-vector of `a` within `rel` of the largest of its kind in `b`.
+fn assert_rates_close(a: &[f64], b: &[f64], rel: f64, what: &str) {
+    let n = a.len() / 6;
+    for kind in [0, 1] {
+        let block = |v: &[f64], i: usize| {
+            let k = 6 * i + 3 * kind;
+            Vector3::new(v[k], v[k + 1], v[k + 2])
+        };
+        let scale = (0..n).map(|i| block(b, i).norm()).fold(0.0, f64::max);
+        assert!(scale > 0.0, "{what}: no motion");
+        for i in 0..n {
+            let d = (block(a, i) - block(b, i)).norm();
+            assert!(d <= rel * scale, "{what}, swimmer {i}: {d:e} of {scale:e}");
+        }
+    }
+}
+
+// One list system carried along a sequence of states (as a run carries it): swimmers drift by
+// a fraction of the skin (no relisting), a few jump by more than half the skin (relisted alone),
+// one swimmer walks across the box in steps of a tenth of its side (crossing faces, relisted at
+// each), and finally every swimmer moves (a rebuild). At every state the rates equal the
+// all-pairs rows' to 1e-13 of the largest of their kind: the same terms (the same switch, the
+// same minimum images), summed in another order (≤ 60 partners, rounding ~1e-16 each).
+#[test]
+fn neighbour_lists_follow_moving_swimmers_and_equal_all_pairs_rows() {
+    let d = asymmetric();
+    for (with_box, with_steric) in [(true, true), (true, false), (false, true)] {
+        let mut s = bulk_scene_apart(400, d, 2e-3, 32, Some(0.5 * d.ell)).unwrap();
+        if !with_box {
+            s.set_box(None).unwrap();
+        }
+        if !with_steric {
+            s.set_steric(None);
+        }
+        let what = format!("box {with_box}, steric {with_steric}");
+        let (y0, _) = s.raw_state();
+        let mut y = y0.to_vec();
+        let mut listed = system_of(&s, &y);
+        listed.set_neighbour_lists(Some(true));
+        let skin = 0.05 * s.cutoff().unwrap();
+        listed.set_skin(Some(skin));
+        let side = s.periodic().map_or(50.0 * d.ell, |b| b.shortest());
+        let mut dy = vec![0.0; y.len()];
+        let mut check = |y: &[f64], listed: &mut AveragedSystem, step: &str| {
+            listed.rhs(0.0, y, &mut dy);
+            assert_rates_close(
+                &dy,
+                &all_pairs_rates(&s, y),
+                1e-13,
+                &format!("{what}, {step}"),
+            );
+        };
+        check(&y, &mut listed, "start");
+        let builds = listed.list_builds();
+        // A drift of a fifth of the skin, all swimmers: the lists stay.
+        for i in 0..400 {
+            y[6 * i] += 0.2 * skin * ((i % 7) as f64 / 7.0 - 0.5);
+        }
+        check(&y, &mut listed, "drift");
+        assert_eq!(
+            listed.list_builds(),
+            builds,
+            "{what}: a drift rebuilt the lists"
+        );
+        // Five swimmers jump by 0.8 skin: relisted alone.
+        for i in [3, 77, 150, 222, 399] {
+            y[6 * i + 1] += 0.8 * skin;
+        }
+        check(&y, &mut listed, "jumps");
+        assert_eq!(
+            listed.list_builds(),
+            builds,
+            "{what}: five jumps rebuilt the lists"
+        );
+        let relists = listed.list_relists();
+        assert!(relists >= 5, "{what}: {relists} relists");
+        // Swimmer 10 walks 1.2 sides along x and z: it crosses faces of the box.
+        for k in 0..12 {
+            y[60] += 0.1 * side;
+            y[62] -= 0.1 * side;
+            check(&y, &mut listed, &format!("walk {k}"));
+        }
+        assert!(listed.list_relists() >= relists + 12);
+        // Every swimmer moves by a skin: rebuilt.
+        for i in 0..400 {
+            y[6 * i + 2] += skin * if i % 2 == 0 { 1.0 } else { -1.0 };
+        }
+        check(&y, &mut listed, "all moved");
+        assert!(listed.list_builds() > builds, "{what}: not rebuilt");
+    }
+}
+
+/// 300 swimmers at φ = 0.3% placed ℓ/2 apart (above the list threshold; the box holds the 6ℓ
+/// cutoff), steric rods (smooth), and one more pair side by side 0.2 µm apart (within the 0.5 µm
+/// range), at 30° to each other (rods held exactly parallel in contact have no unique closest
+/// points): the contact is there from the start, so the implicit clusters and the refinement of
+/// fast swimmers act.
+fn contact_scene() -> Scene {
+    let d = Dumbbell::default();
+    let base = bulk_scene_apart(300, d, 3e-3, 7, Some(0.5 * d.ell)).unwrap();
+    let side = base.periodic().unwrap().shortest();
+    let y = 2.0 * d.a1 + 0.2e-6;
+    let tilted = Vector3::new(3f64.sqrt() / 2.0, 0.0, 0.5);
+    // The first spot of a coarse grid where the pair fits among the others.
+    for k in 0..1000 {
+        let c =
+            Vector3::new((k % 10) as f64, ((k / 10) % 10) as f64, (k / 100) as f64) * (0.1 * side);
+        let mut s = base.clone();
+        if s.add(d, c, Vector3::x()).is_ok()
+            && s.add(d, c + Vector3::new(0.0, y, 0.0), tilted).is_ok()
+        {
+            return s;
+        }
+    }
+    panic!("no room for the pair");
+}
+
+fn run(mut s: Scene, spec: IntegratorSpec, periods: f64) -> Simulation {
+    s.set_integrator(Some(spec));
+    let mut sim = Simulation::new(s);
+    sim.run_periods(periods).unwrap();
+    sim
+}
+
+// The suspension stepper against RK4 at T/256 over 20 periods (the pair in contact makes RK4
+// converge late: T/256 is within 1e-8 of T/512, a tenth of the smallest error compared below):
+// at the default tolerance within 1e-3 of the RMS displacement (the issue's bar), the error
+// falls with tol, and its order against the step count, ROS34PW2's 3, measured above 2 (the
+// errors and step counts of three tolerances give two estimates; each must pass).
+#[test]
+fn the_suspension_stepper_converges_to_fine_rk4() {
+    let period = 2.0 * std::f64::consts::PI / Dumbbell::default().omega;
+    let state = |sim: &Simulation| sim.scene().raw_state().0.to_vec();
+    let fine = state(&run(
+        contact_scene(),
+        IntegratorSpec::rk4(period / 512.0).unwrap(),
+        20.0,
+    ));
+    let reference = state(&run(
+        contact_scene(),
+        IntegratorSpec::rk4(period / 256.0).unwrap(),
+        20.0,
+    ));
+    let reference_error = displacement_error(&reference, &fine);
+    assert!(reference_error < 1e-8, "rk4 T/256: {reference_error:e}");
+    let mut rows = Vec::new();
+    for tol in [1e-2, 1e-3, 1e-4] {
+        let sim = run(
+            contact_scene(),
+            IntegratorSpec::suspension(tol).unwrap(),
+            20.0,
+        );
+        let err = displacement_error(&state(&sim), &reference);
+        rows.push((tol, err, sim.stats().steps as f64));
+    }
+    assert!(rows[1].1 < 1e-3, "{rows:?}");
+    let orders: Vec<f64> = rows
+        .windows(2)
+        .map(|w| (w[0].1 / w[1].1).ln() / (w[1].2 / w[0].2).ln())
+        .collect();
+    assert!(
+        rows.windows(2).all(|w| w[1].1 < w[0].1) && orders.iter().all(|&p| p > 2.0),
+        "{rows:?}: orders {orders:?}"
+    );
+}
+
+// Over 300 periods from a contact the run never accepts an overlap (the guard would stop it) and
+// the smallest sphere gap, read every 10 periods, stays positive; the pair in contact was pushed
+// apart (its gap grew) and a few fast swimmers were refined.
+#[test]
+fn suspension_runs_keep_swimmers_apart() {
+    let s = contact_scene();
+    let pair = (s.count() - 2, s.count() - 1);
+    let gap_of_pair =
+        |sim: &Simulation| Observable::DistanceH(pair.0, pair.1).evaluate(sim).unwrap()[0];
+    let mut sim = Simulation::new(s);
+    let start = gap_of_pair(&sim);
+    for _ in 0..30 {
+        sim.run_periods(10.0).unwrap();
+        let gap = Observable::MinGap.evaluate(&sim).unwrap()[0];
+        assert!(gap > 0.0, "min gap {gap:e} at t = {:e}", sim.time());
+    }
+    assert!(
+        gap_of_pair(&sim) > start,
+        "the pair in contact did not separate"
+    );
+    assert!(sim.stats().refined_steps > 0, "{:?}", sim.stats());
+}
+
+// The default integrator of a suspension is the suspension stepper, and `auto` picks it; the
+// spring model refuses it, naming the averaged model.
+#[test]
+fn suspensions_default_to_the_suspension_stepper() {
+    let s = contact_scene();
+    assert!(matches!(s.integrator(), IntegratorSpec::Suspension { .. }));
+    assert!(s.integrator_info().unwrap().contains("suspension"));
+    let mut auto = contact_scene();
+    auto.set_integrator(Some(IntegratorSpec::auto(1e-4).unwrap()));
+    let info = auto.integrator_info().unwrap();
+    assert!(info.contains("runs suspension(1e-4)"), "{info}");
+    let mut micro = contact_scene();
+    micro.set_model(Model::Micro);
+    micro.set_integrator(Some(IntegratorSpec::suspension(1e-3).unwrap()));
+    let e = Simulation::new(micro).run_periods(0.01).unwrap_err();
+    assert!(e.to_string().contains("averaged"), "{e}");
+}
+
+// A run split by save and load (the stepper starts afresh) or by an interrupt ends where one run
+// does to within the tolerance's reach: 1e-2 of the RMS displacement at tol 1e-4 (the two paths
+// take different steps; each is within ~1e-4 of the exact one, see the convergence test).
+#[test]
+fn save_load_and_interrupts_mid_run_continue_the_run() {
+    let spec = IntegratorSpec::suspension(1e-4).unwrap();
+    let whole = run(contact_scene(), spec, 40.0);
+    let first = run(contact_scene(), spec, 20.0);
+    let json = first.scene().to_json().unwrap();
+    let mut second = Simulation::new(Scene::from_json(&json).unwrap());
+    assert_eq!(second.scene().integrator(), spec);
+    second.run_periods(20.0).unwrap();
+    let (a, b) = (second.scene().raw_state().0, whole.scene().raw_state().0);
+    let err = displacement_error(a, b);
+    assert!(err < 1e-2, "save/load: {err:e}");
+
+    let mut s = contact_scene();
+    s.set_integrator(Some(spec));
+    let mut stopped = Simulation::new(s);
+    let calls = Arc::new(AtomicU64::new(0));
+    let c = calls.clone();
+    stopped.set_interrupt(Some(Arc::new(move || {
+        c.fetch_add(1, Ordering::Relaxed) >= 5
+    })));
+    let period = stopped.period().unwrap();
+    let e = stopped.run(40.0 * period).unwrap_err();
+    assert!(matches!(e, EngineError::Interrupted { .. }), "{e}");
+    let at = stopped.time();
+    assert!(at > 0.0 && at < 40.0 * period, "{}", at / period);
+    assert!(stopped.scene().raw_state().0.iter().all(|v| v.is_finite()));
+    stopped.set_interrupt(None);
+    stopped.run(40.0 * period - at).unwrap();
+    let err = displacement_error(stopped.scene().raw_state().0, b);
+    assert!(err < 1e-2, "interrupted: {err:e}");
+}
