@@ -124,6 +124,7 @@ impl From<BenchKind> for swimlab::bench::report::Kind {
             BenchKind::Pairs => Kind::Pairs,
             BenchKind::Scaling => Kind::Scaling,
             BenchKind::Ewald => Kind::Ewald,
+            BenchKind::Suspension => Kind::Suspension,
         }
     }
 }
@@ -150,6 +151,11 @@ enum BenchKind {
     /// 15,625 spheres (--quick: up to 512; Beenakker up to 4,096), with open space for scale, the
     /// methods' difference against the tolerance and the crossover "auto" uses.
     Ewald,
+    /// Bulk suspensions of the averaged model (~15 min; --quick: ~1 min): one right-hand side of
+    /// 10,000 swimmers in a box with a cutoff against 1,024 all pairs, side by side; add_random of
+    /// 100,000; suspension(tol)'s error against RK4 and its order; runs of 1,000 and 10,000
+    /// swimmers for 1e4 periods and 100,000 for 1e3, the cost per swimmer-period.
+    Suspension,
 }
 
 fn main() -> ExitCode {

@@ -1,7 +1,7 @@
 //! `swimlab bench ...`: each benchmark's tables printed and written as CSV, with its pictures,
 //! under out/bench/. The command line only names the benchmark.
 
-use super::{backends, ewald, pairs, plots, scaling, stability, work_precision};
+use super::{backends, ewald, pairs, plots, scaling, stability, suspension, work_precision};
 use crate::engine::Model;
 
 /// The benchmarks `swimlab bench` runs.
@@ -19,6 +19,8 @@ pub enum Kind {
     Scaling,
     /// The periodic box's mobility product by both Ewald methods against size.
     Ewald,
+    /// Bulk suspensions of the averaged model: right-hand side, placement, long runs, accuracy.
+    Suspension,
 }
 
 /// Run one benchmark, print its tables and write its CSV and pictures under out/bench/.
@@ -140,6 +142,7 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
             println!("picture: out/bench/scaling.png");
             println!("\nCSV written to out/bench/scaling.csv");
         }
+        Kind::Suspension => run_suspension(quick)?,
         Kind::Backends => {
             match crate::engine::gpu::device() {
                 Ok(d) => println!("GPU adapter: {}", d.describe()),
@@ -167,5 +170,116 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
             println!("\nCSV written to out/bench/backends.csv");
         }
     }
+    Ok(())
+}
+
+/// `swimlab bench suspension`: the figures of the bulk suspension (see [`suspension`]).
+fn run_suspension(quick: bool) -> Result<(), String> {
+    let e = |e: crate::engine::EngineError| e.to_string();
+    let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
+    let d = crate::engine::Dumbbell::default();
+    let (n, m, rounds) = if quick {
+        (2000, 256, 3)
+    } else {
+        (10_000, 1024, 9)
+    };
+    println!(
+        "one right-hand side, {n} swimmers at phi = 0.1% in a box, cutoff 6 ell (neighbour lists), against {m} swimmers all pairs (lanes), {} threads, vector unit {}, alternating rounds of 5:",
+        rayon::current_num_threads(),
+        crate::engine::simd::vector_unit()
+    );
+    let bulk = suspension::bulk_scene(n, d, 1e-3, 2026).map_err(e)?;
+    let dense = suspension::dense_scene(m, d).map_err(e)?;
+    let r = suspension::rhs_rounds(&bulk, &dense, rounds, 5).map_err(e)?;
+    let t = suspension::rhs_table(n, m, &r);
+    println!("{}", t.render());
+    println!(
+        "median ratio {:.3}",
+        suspension::median(r.iter().map(|r| r.suspension / r.dense).collect())
+    );
+    t.write_csv(std::path::Path::new("out/bench/suspension_rhs.csv"))
+        .map_err(io)?;
+    let placed = if quick { 10_000 } else { 100_000 };
+    let secs = suspension::placement_seconds(placed, d, 1e-3, 7).map_err(e)?;
+    println!("\nadd_random of {placed} swimmers in a box at phi = 0.1% with gap: ell: {secs:.2} s");
+    let (periods, tols): (f64, &[f64]) = if quick {
+        (10.0, &[1e-2, 1e-3])
+    } else {
+        (100.0, &[1e-2, 1e-3, 1e-4, 1e-5])
+    };
+    let (reference, rows) = suspension::accuracy(periods, tols).map_err(e)?;
+    let mut t = crate::bench::table::Table::new(&[
+        "tol",
+        "error / rms displacement",
+        "steps",
+        "rhs",
+        "seconds",
+    ]);
+    for (tol, err, steps, rhs, secs) in &rows {
+        t.rows.push(vec![
+            format!("{tol:e}"),
+            format!("{err:.3e}"),
+            steps.to_string(),
+            rhs.to_string(),
+            format!("{secs:.2}"),
+        ]);
+    }
+    println!(
+        "\naccuracy: 1,000 swimmers at phi = 0.3% placed ell/2 apart, {periods} periods, suspension(tol) against rk4(T/128) (which differs from rk4(T/256) by {reference:.2e}):\n{}",
+        t.render()
+    );
+    for w in rows.windows(2) {
+        let order = (w[0].1 / w[1].1).ln() / (w[1].2 as f64 / w[0].2 as f64).ln();
+        println!(
+            "error against steps from tol {:e} to {:e}: order {order:.2}",
+            w[0].0, w[1].0
+        );
+    }
+    t.write_csv(std::path::Path::new("out/bench/suspension_accuracy.csv"))
+        .map_err(io)?;
+    let plan: &[(usize, f64, usize)] = if quick {
+        &[(500, 200.0, 2), (2000, 200.0, 2)]
+    } else {
+        &[(1000, 1e4, 10), (10_000, 1e4, 10), (100_000, 1e3, 1)]
+    };
+    let first = if quick { 200.0 } else { 1000.0 };
+    let per_first = format!("s per swimmer-period (first {first} periods)");
+    let mut integrator = String::new();
+    let mut t = crate::bench::table::Table::new(&[
+        "swimmers",
+        "periods",
+        "seconds",
+        &per_first,
+        "steps",
+        "rejected",
+        "rhs",
+        "refined steps",
+    ]);
+
+    for &(n, periods, stretches) in plan {
+        let run = suspension::run_bulk(n, periods, stretches, 2026).map_err(e)?;
+        let (_, secs) = *run.stretches.last().unwrap_or(&(0.0, 0.0));
+        let st = run.stats;
+        if integrator.is_empty() {
+            println!("integrator: {}", run.integrator);
+            integrator = run.integrator.clone();
+        }
+        println!("{n} swimmers, {periods} periods: {secs:.1} s");
+        t.rows.push(vec![
+            n.to_string(),
+            format!("{periods}"),
+            format!("{secs:.1}"),
+            run.cost_per_swimmer_period(first)
+                .map_or("-".into(), |c| format!("{c:.3e}")),
+            st.steps.to_string(),
+            st.rejected.to_string(),
+            st.rhs_evals.to_string(),
+            st.refined_steps.to_string(),
+        ]);
+    }
+    println!("\nbulk suspensions at phi = 0.1% (box, cutoff 6 ell, steric rods, the default integrator):\n{}", t.render());
+    t.write_csv(std::path::Path::new("out/bench/suspension_runs.csv"))
+        .map_err(io)?;
+    println!("\nCSV written to out/bench/suspension_*.csv");
     Ok(())
 }
