@@ -1,6 +1,6 @@
 //! `write_csv(path, rows)` / `write_csv(path, columns, rows)`: tables from scripts.
 
-use super::convert::{script_error, ScriptResult};
+use super::convert::{describe, script_error, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use crate::engine::files::write_atomically;
 use rhai::{Array, Dynamic, Engine, Map};
@@ -46,10 +46,10 @@ fn maps(rows: Array) -> ScriptResult<Vec<Map>> {
     rows.into_iter()
         .enumerate()
         .map(|(k, r)| {
-            let t = r.type_name();
+            let got = describe(&r);
             r.try_cast::<Map>().ok_or_else(|| {
                 script_error(format!(
-                    "write_csv: row {k} must be an object map such as #{{ D: 10.0, drift: 1e-6 }}, got {t}"
+                    "write_csv: row {k} must be an object map such as #{{ D: 10.0, drift: 1e-6 }}, got {got}"
                 ))
             })
         })

@@ -3,7 +3,7 @@
 use super::{
     csv_api, dumbbell_api, field_api, float_cmp, integrator_api, interrupt, limits, observable_api,
     panic_guard::guard, params, picture_api, plot_api, render_error, scene_api, stdlib, sweep_api,
-    util_api,
+    types, util_api,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -22,6 +22,7 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     let mut engine = Engine::new();
     engine.set_max_expr_depths(256, 256);
     limits::apply(&mut engine);
+    types::register(&mut engine);
     dumbbell_api::register(&mut engine);
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);

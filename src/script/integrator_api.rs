@@ -18,7 +18,6 @@ pub fn call_forms() -> String {
 
 /// Register the `Integrator` type and its constructors.
 pub fn register(engine: &mut Engine) {
-    engine.register_type_with_name::<IntegratorSpec>("Integrator");
     for m in METHODS {
         let make = m.make;
         let what = format!("{}({p}): {p}", m.name, p = m.parameter);
@@ -33,7 +32,6 @@ pub fn register(engine: &mut Engine) {
             lift(IntegratorSpec::stroboscopic_with(tol, Some(inner)))
         },
     );
-    super::convert::register_display::<IntegratorSpec>(engine);
     engine.register_fn("==", |a: IntegratorSpec, b: IntegratorSpec| a == b);
 }
 

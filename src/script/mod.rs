@@ -26,6 +26,7 @@ mod show;
 mod signatures;
 pub mod stdlib;
 mod sweep_api;
+mod types;
 mod util_api;
 
 pub use convert::{engine_message, script_error, setting_in_script, ScriptResult};

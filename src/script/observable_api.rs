@@ -1,7 +1,7 @@
 //! Observables as script values (type `Observable`), `s.observe(obs)`, triggers (type `Trigger`),
 //! and recorders (type `Recorder`): `s.record([...], trigger)`, `.rows`, `.to_csv(path)`.
 
-use super::convert::{index, lift, number, register_display, script_error, vector3, ScriptResult};
+use super::convert::{describe, index, lift, number, script_error, vector3, ScriptResult};
 use super::docs::{self, doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::{Observable, Recorder, Trigger};
@@ -68,8 +68,8 @@ fn trigger_of(v: &Dynamic) -> ScriptResult<Trigger> {
         return Ok(Trigger::EveryPeriods(number("record(..., every)", v)?));
     }
     Err(script_error(format!(
-        "the trigger must be a number of periods or every_periods(n), every_seconds(t), at_times([..]), at_end(); got {v} ({})",
-        v.type_name()
+        "the trigger must be a number of periods or every_periods(n), every_seconds(t), at_times([..]), at_end(); got {}",
+        describe(v)
     )))
 }
 
@@ -79,9 +79,8 @@ fn observables_of(list: &Array) -> ScriptResult<Vec<Observable>> {
         .map(|(k, o)| {
             o.clone().try_cast::<Observable>().ok_or_else(|| {
                 script_error(format!(
-                    "record: element {k} is not an observable (got {} ({})); use R_H(0), q(0, 1), polarization(), ...",
-                    o,
-                    o.type_name()
+                    "record: element {k} is not an observable (got {}); use R_H(0), q(0, 1), polarization(), ...",
+                    describe(o)
                 ))
             })
         })
@@ -90,11 +89,7 @@ fn observables_of(list: &Array) -> ScriptResult<Vec<Observable>> {
 
 /// Register observables, triggers and recorders.
 pub fn register(engine: &mut Engine) {
-    register_display::<Observable>(engine);
-    register_display::<Trigger>(engine);
-    register_display::<RecorderHandle>(engine);
     engine
-        .register_type_with_name::<Observable>("Observable")
         .register_get("name", |o: &mut Observable| o.name())
         .register_get("unit", |o: &mut Observable| o.unit().to_string());
 
@@ -171,7 +166,6 @@ pub fn register(engine: &mut Engine) {
         );
 
     engine
-        .register_type_with_name::<Trigger>("Trigger")
         .register_fn("every_periods", |n: Dynamic| -> ScriptResult<Trigger> {
             let t = Trigger::EveryPeriods(number("every_periods(n): n", &n)?);
             lift(t.validate()).map(|_| t)
@@ -192,7 +186,6 @@ pub fn register(engine: &mut Engine) {
         .register_fn("at_end", || Trigger::AtEnd);
 
     engine
-        .register_type_with_name::<RecorderHandle>("Recorder")
         .register_fn(
             "record",
             |s: &mut SceneHandle, list: Array, every: Dynamic| -> ScriptResult<RecorderHandle> {

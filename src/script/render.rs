@@ -10,7 +10,8 @@ use rhai::{EvalAltResult, Position};
 
 /// Render a script error against its source text.
 pub fn render_error(name: &str, source: &str, err: &EvalAltResult) -> String {
-    let d = describe(err);
+    let mut d = describe(err);
+    d.msg = super::types::in_words(&d.msg);
     let mut out = String::new();
     match d.pos.line() {
         Some(line) => {
@@ -165,6 +166,9 @@ fn function_not_found(sig: &str) -> String {
         args.split(", ").map(shown_type).collect()
     };
     let call = format!("{name}({})", args.join(", "));
+    if is_operator(name) {
+        return operator_not_found(name, &args);
+    }
     let voc = vocabulary();
     if let Some((alias, f)) = name.rsplit_once("::") {
         // A module function: look for it (or the closest name) in every stdlib module, since
@@ -209,6 +213,31 @@ fn function_not_found(sig: &str) -> String {
         ),
         None => format!("there is no function {call}; :help lists every name"),
     }
+}
+
+/// Whether `name` is an operator (`/`, `+=`, `<`, ...) rather than a function name.
+fn is_operator(name: &str) -> bool {
+    !name.is_empty() && !name.chars().any(|c| c.is_alphanumeric() || c == '_')
+}
+
+/// An operator that has no form for these operand types: "cannot apply / to float and string".
+fn operator_not_found(op: &str, args: &[String]) -> String {
+    let operands = match args {
+        [a] => format!("a {a}"),
+        [a, b] => format!("{a} and {b}"),
+        _ => args.join(", "),
+    };
+    let numeric = ["+", "-", "*", "/", "%", "**", "<", "<=", ">", ">="]
+        .iter()
+        .any(|o| op.trim_end_matches('=') == *o || op == *o);
+    let fix = if args.iter().any(|a| a == "string") && numeric {
+        "; a number was given as a string: write 2, not \"2\" (parse_float(s) or parse_int(s) converts)"
+    } else if numeric {
+        "; both sides must be numbers (int or float)"
+    } else {
+        ""
+    };
+    format!("the operator {op} cannot be applied to {operands}{fix}")
 }
 
 fn module_not_found(m: &str) -> String {

@@ -5,7 +5,7 @@
 //! `let t = s;` names the same scene, as in Python. Every run of a script's scene stops on Ctrl-C
 //! ([`interrupt`]).
 
-use super::convert::{array3, index, lift, number, script_error, ScriptResult};
+use super::convert::{array3, describe, index, lift, number, script_error, ScriptResult};
 use super::docs::{self, doc_entry, Doc};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
@@ -79,8 +79,9 @@ impl SceneHandle {
 fn swimmer_index(v: &Dynamic) -> ScriptResult<usize> {
     match v.as_int() {
         Ok(i) => index(i),
-        Err(t) => Err(script_error(format!(
-            "a swimmer index must be an integer such as 0, got {v} ({t})"
+        Err(_) => Err(script_error(format!(
+            "a swimmer index must be an integer such as 0, got {}",
+            describe(v)
         ))),
     }
 }
@@ -231,10 +232,7 @@ fn with_bar<T>(
 
 /// Register the `Scene` type and its methods and properties.
 pub fn register(engine: &mut Engine) {
-    engine
-        .register_type_with_name::<SceneHandle>("Scene")
-        .register_fn("scene", SceneHandle::default);
-    super::convert::register_display::<SceneHandle>(engine);
+    engine.register_fn("scene", SceneHandle::default);
 
     // Building.
     engine.register_fn(
@@ -248,8 +246,8 @@ pub fn register(engine: &mut Engine) {
         "add",
         |_: &mut SceneHandle, d: Dynamic| -> ScriptResult<INT> {
             Err(script_error(format!(
-                "add expects a Dumbbell such as dumbbell(#{{ phase: 0.0 }}), got {d} ({})",
-                d.type_name()
+                "add expects a Dumbbell such as dumbbell(#{{ phase: 0.0 }}), got {}",
+                describe(&d)
             )))
         },
     );
@@ -384,8 +382,8 @@ pub fn register(engine: &mut Engine) {
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
                     script_error(format!(
-                        "phases must be an array of numbers, got {v} ({})",
-                        v.type_name()
+                        "phases must be an array of numbers, got {}",
+                        describe(&v)
                     ))
                 })?;
                 let ph = arr

@@ -2,7 +2,7 @@
 //! `s.coefficients`, `s.overlaps`, each read from its engine table), `s.steric`, `s.cutoff`,
 //! `s.integrator`, and the read-only `time`, `count`, `period`, `stiff_rate`, `backend_info`.
 
-use super::convert::{lift, number, script_error, unknown_choice, ScriptResult};
+use super::convert::{describe, lift, number, script_error, unknown_choice, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::choice::{self, Named};
@@ -18,7 +18,7 @@ fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {
     v.clone()
         .into_immutable_string()
         .map(|s| s.to_string())
-        .map_err(|t| script_error(format!("{what} must be a string, got {v} ({t})")))
+        .map_err(|_| script_error(format!("{what} must be a string, got {}", describe(v))))
 }
 
 /// `s.steric = #{ range, stiffness[, body] }` (m, N/m, "spheres" or "rods") or `()` for none.
@@ -29,7 +29,8 @@ fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
     }
     let Some(map) = v.clone().try_cast::<rhai::Map>() else {
         return Err(script_error(format!(
-            "s.steric must be a map or (), got {v}; {FIX}"
+            "s.steric must be a map or (), got {}; {FIX}",
+            describe(v)
         )));
     };
     let (mut range, mut stiffness, mut body) = (None, None, StericBody::Spheres);
@@ -163,7 +164,8 @@ pub fn register(engine: &mut Engine) {
                     .and_then(|i| u64::try_from(i).ok())
                     .ok_or_else(|| {
                         script_error(format!(
-                            "seed must be a whole number of 0 or more, got {v}; e.g. s.seed = 42"
+                            "seed must be a whole number of 0 or more, got {}; e.g. s.seed = 42",
+                            describe(&v)
                         ))
                     })?;
                 s.borrow_mut().scene_mut().set_seed(seed);
@@ -258,9 +260,10 @@ pub fn register(engine: &mut Engine) {
                         ))),
                         None => Err(unknown_choice("integrator", &name, &["default"])),
                     },
-                    Err(t) => Err(script_error(format!(
-                        "integrator must be {} or \"default\", got {v} ({t})",
-                        super::integrator_api::call_forms()
+                    Err(_) => Err(script_error(format!(
+                        "integrator must be {} or \"default\", got {}",
+                        super::integrator_api::call_forms(),
+                        describe(&v)
                     ))),
                 }
             },

@@ -21,6 +21,9 @@ pub struct Vocabulary {
 /// A Rust type name as a script user knows it.
 fn script_type(t: &str) -> String {
     let t = t.trim().trim_start_matches("&mut ").trim_start_matches('&');
+    if let Some(name) = super::types::script_name(t) {
+        return name.to_string();
+    }
     let last = t.rsplit("::").next().unwrap_or(t);
     match last {
         "i64" | "INT" => "int".into(),

@@ -1,0 +1,183 @@
+//! Issue 38, "nothing lost, nothing hangs, round two": the newer surfaces (boxes, noise, fields,
+//! stroboscopic and `auto`, trajectories, pictures, sweeps) tried as a hostile new user would.
+//! Each case runs in its own `swimlab` process under a time limit, so a hang or an abort fails
+//! the test instead of stalling it, and a panic shows as the "internal error" the script boundary
+//! turns it into.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// Well above any case's real cost (each is a few periods of a pair at most), far below what the
+/// hangs and crawls these cases once were would take.
+const LIMIT: Duration = Duration::from_secs(60);
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("swimlab-round-two-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A fresh folder for one case.
+fn case_dir() -> PathBuf {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static N: AtomicU64 = AtomicU64::new(0);
+    let d = dir().join(format!("case-{}", N.fetch_add(1, Ordering::SeqCst)));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Run `swimlab run` on `script` in `cwd` to completion within [`LIMIT`].
+fn run_in(script: &str, cwd: &Path) -> Output {
+    let file = cwd.join("case.rhai");
+    std::fs::write(&file, script).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", file.to_str().unwrap()])
+        .current_dir(cwd)
+        .env("SWIMLAB_PROGRESS", "0")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start swimlab");
+    let start = Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            return child.wait_with_output().unwrap();
+        }
+        if start.elapsed() > LIMIT {
+            let _ = child.kill();
+            panic!("did not finish within {LIMIT:?} (a hang):\n{script}");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// stdout and stderr of a run.
+fn text(out: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+/// Run `script`; check the exit code, that the output holds every fragment, and that no panic,
+/// Rust path or Rust debug text surfaced.
+#[track_caller]
+fn case(script: &str, fragments: &[&str], code: i32) -> String {
+    let out = run_in(script, &case_dir());
+    let text = text(&out);
+    assert_eq!(
+        out.status.code(),
+        Some(code),
+        "exit code of:\n{script}\n---\n{text}"
+    );
+    for f in fragments {
+        assert!(
+            text.contains(f),
+            "missing {f:?} for:\n{script}\n---\n{text}"
+        );
+    }
+    for bad in [
+        "internal error",
+        "panicked",
+        "swimlab::",
+        "Os {",
+        "IoError",
+        "Function not found",
+    ] {
+        assert!(!text.contains(bad), "{bad:?} for:\n{script}\n---\n{text}");
+    }
+    text
+}
+
+const PAIR: &str = "let s = scene();\ns.add(dumbbell(#{ center: [-25e-6, 0, 0] }));\ns.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 }));\n";
+
+/// Every swimlab type given where another is wanted is named in script words, and `display`
+/// shows every swimlab value as `print` does.
+#[test]
+fn script_types_are_named_in_words() {
+    case(
+        &format!("{PAIR}s.temperature = euler(1e-6);"),
+        &["temperature must be a number, got euler(1e-6) (Integrator)"],
+        1,
+    );
+    case(
+        &format!("{PAIR}s.record([R_H(0)], s.field(\"density\"));"),
+        &["got Field(density", "(Field)"],
+        1,
+    );
+    case(
+        &format!("{PAIR}s.add(every_periods(1));"),
+        &["(Trigger)"],
+        1,
+    );
+    case(
+        &format!("{PAIR}s.run(s);"),
+        &["got Scene(2 swimmers", "(Scene)"],
+        1,
+    );
+    case(
+        &format!("{PAIR}let r = s.record([R_H(0)], 1);\ns.phases = r;"),
+        &["(Recorder)"],
+        1,
+    );
+    case(
+        &format!("{PAIR}R_H(s);"),
+        &["R_H cannot be called as R_H(Scene)"],
+        1,
+    );
+    case(
+        &format!("{PAIR}s.mu = plot(#{{ x: [1, 2], y: [1, 2] }});"),
+        &["(Picture)"],
+        1,
+    );
+    let shown = case(
+        &format!(
+            "{PAIR}let f = s.field(\"density\");\ndisplay(f);\nprint(f);\ndisplay(euler(1e-6));\ndisplay(R_H(0));\ndisplay(every_periods(2));\ndisplay(dumbbell());"
+        ),
+        &[],
+        0,
+    );
+    let lines: Vec<&str> = shown.lines().collect();
+    assert!(lines[0].starts_with("Field(density, grid"), "{shown}");
+    assert_eq!(lines[0], lines[1], "display and print agree: {shown}");
+    assert!(
+        lines[2].starts_with("euler(") && lines[4].contains("every 2 periods"),
+        "{shown}"
+    );
+}
+
+/// Wrong types into stdlib functions and operators name the operand types and the fix.
+#[test]
+fn stdlib_and_operators_name_wrong_types() {
+    case(
+        "import \"lattice\" as lattice;\nlet s = scene();\ns.box = [1e-4, 1e-4, 1e-4];\nlattice::fill(s.box, \"2\", 2, 2);",
+        &["nx must be a whole number of points >= 1", "got \"2\" (a string)"],
+        1,
+    );
+    case(
+        "import \"lattice\" as lattice;\nlattice::cubic(2, 2, 2, \"1e-5\");",
+        &["spacing must be a positive length in m"],
+        1,
+    );
+    let t = case(
+        "let x = 1.0 / \"2\";",
+        &["the operator / cannot be applied to float and string"],
+        1,
+    );
+    assert!(!t.contains("did you mean"), "{t}");
+}
+
+/// `param` refuses a name that no `--set` can give.
+#[test]
+fn param_refuses_names_no_set_can_give() {
+    case(
+        "param(\"\", 1e-6);",
+        &["param(\"\", ...): the name must be a variable name"],
+        1,
+    );
+    case("param(\"a b\", 1);", &["must be a variable name"], 1);
+    case("print(param(\"D\", 2.5));", &["2.5"], 0);
+}
