@@ -181,3 +181,54 @@ fn param_refuses_names_no_set_can_give() {
     case("param(\"a b\", 1);", &["must be a variable name"], 1);
     case("print(param(\"D\", 2.5));", &["2.5"], 0);
 }
+
+/// One check of a run's end for every integrator: a run past 1e9 stroke periods, which a saved
+/// scene could not be loaded at, is refused with the numbers before it starts, by stroboscopic
+/// averaging and `auto` as by the direct methods, in open space and in a box; a scene run right
+/// up to it saves and loads.
+#[test]
+fn no_integrator_runs_past_the_latest_time() {
+    for integrator in [
+        "stroboscopic(1e-2)",
+        "auto(1e-3)",
+        "dopri5(1e-6)",
+        "rk4(1e-6)",
+    ] {
+        for place in ["", "s.box = [120e-6, 120e-6, 120e-6];\n"] {
+            case(
+                &format!("{PAIR}{place}s.integrator = {integrator};\ns.run_periods(9223372036854775807);"),
+                &["past the latest time a scene may hold", "1e9 stroke periods", "run at most"],
+                1,
+            );
+        }
+    }
+    case(
+        &format!("{PAIR}s.integrator = stroboscopic(1e-2);\ns.run_periods(2e9);"),
+        &["this run would end at t = 2.513274e7 s (2.000000e9 periods)"],
+        1,
+    );
+    case(
+        "let s = scene();\ns.add(dumbbell());\ns.integrator = auto(1e-3);\ns.run_periods(1e9);\ns.save(\"at_the_end.json\");\nlet t = load_scene(\"at_the_end.json\");\nprint(t.time / t.period);\ntry { t.run_periods(1); } catch (e) { print(e); }",
+        &["1000000000", "past the latest time"],
+        0,
+    );
+}
+
+/// A run whose cost will be far beyond what its length suggests says so when it starts: spectral
+/// Ewald sums on a few spheres (an FFT grid per product whatever their number).
+#[test]
+fn a_costly_ewald_method_says_so_when_the_run_starts() {
+    let scene = "let s = scene();\ns.box = [120e-6, 120e-6, 120e-6];\ns.add(dumbbell(#{ center: [-30e-6, 0, 0] }));\ns.add(dumbbell(#{ phase: 1.0 }));\ns.add(dumbbell(#{ center: [30e-6, 0, 0], phase: 2.0 }));\n";
+    let t = case(
+        &format!("{scene}s.ewald_method = \"spectral\";\ns.run(1e-6);\ns.run(1e-6);"),
+        &[
+            "note: this run will cost far more than its length suggests",
+            "with 6 spheres",
+            "s.ewald_method = \"auto\"",
+        ],
+        0,
+    );
+    assert_eq!(t.matches("note:").count(), 2, "once a run: {t}");
+    let t = case(&format!("{scene}s.run(1e-6);"), &[], 0);
+    assert!(!t.contains("note:"), "{t}");
+}

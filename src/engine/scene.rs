@@ -9,8 +9,10 @@
 use super::averaged::AveragedSystem;
 use super::backend::Backend;
 use super::contacts::{Contacts, Overlaps, Steric};
-use super::error::{invalid, require_finite, require_positive, unsupported, Result, Setting};
-use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL};
+use super::error::{
+    invalid, require_finite, require_positive, unsupported, EngineError, Result, Setting,
+};
+use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_FROM_SPHERES};
 use super::integrators::{IntegratorSpec, OdeSystem, Stats};
 use super::micro::MicroSystem;
 use super::mobility::Mobility;
@@ -389,6 +391,35 @@ impl Scene {
     /// Set how the box's mobility products are summed.
     pub fn set_ewald_method(&mut self, method: EwaldMethod) {
         self.ewald_method = method;
+    }
+
+    /// What makes the next run far costlier than its length suggests, each as a notice of its
+    /// kind with the fix: spectral Ewald sums chosen for a box of few spheres. Its FFT grid is
+    /// transformed six times a product whatever the number of spheres, while Beenakker's sums
+    /// shrink as N²; below a quarter of the crossover they cost (700/N)² ≳ 16 times less.
+    pub fn cost_notices(&self) -> Vec<(&'static str, EngineError)> {
+        let mut out = Vec::new();
+        let spheres = 2 * self.count();
+        if self.model == Model::Micro
+            && self.ewald_method == EwaldMethod::Spectral
+            && spheres < SPECTRAL_FROM_SPHERES / 4
+        {
+            if let Ok(Some(e)) = self.ewald() {
+                if let Some(g) = e.spectral() {
+                    let [a, b, c] = g.grid();
+                    out.push((
+                        "spectral Ewald",
+                        unsupported(
+                            format!(
+                                "this run will cost far more than its length suggests: spectral Ewald sums transform a {a}x{b}x{c} grid six times for every mobility product, whatever the number of spheres, and with {spheres} spheres Beenakker's sums (O(N^2), faster below {SPECTRAL_FROM_SPHERES} spheres) cost far less"
+                            ),
+                            &[Setting::EwaldMethod("auto"), Setting::EwaldMethod("beenakker")],
+                        ),
+                    ));
+                }
+            }
+        }
+        out
     }
 
     /// The box's periodic mobility for the sphere models (`None` in open space), its products by

@@ -11,7 +11,7 @@ use super::observable::Observable;
 use super::plan;
 use super::recorder::{Recorder, Trigger};
 use super::scene::Scene;
-use super::stepping::{Interrupt, Progress, RunControl, Workspace};
+use super::stepping::{Interrupt, Notice, Progress, RunControl, Workspace};
 use nalgebra::Vector3;
 
 /// A scene and what runs it. See the [module docs](self).
@@ -77,6 +77,12 @@ impl Simulation {
         self.control.set_progress(p);
     }
 
+    /// Tell `n` what a run says while it goes on: a cost far beyond what its length suggests,
+    /// and why (`None`: no one).
+    pub fn set_notice(&mut self, n: Option<Notice>) {
+        self.control.set_notice(n);
+    }
+
     // ----- running -------------------------------------------------------------------------
 
     /// Advance the scene by `duration` seconds. Equivalent to:
@@ -93,7 +99,9 @@ impl Simulation {
     ///     for each recorder due at this time (steps end exactly on due times): take a row
     /// ```
     /// Recorders also take a row at the end of the run if their trigger is "at end". Rows taken
-    /// before an error or interrupt are kept.
+    /// before an error or interrupt are kept. A run whose cost will be far beyond what its length
+    /// suggests says so when it starts (a notice, [`Scene::cost_notices`]), and so does stroboscopic
+    /// averaging when it falls back to direct integration.
     pub fn run(&mut self, duration: f64) -> Result<()> {
         require_finite("duration", duration)?;
         if duration < 0.0 {
@@ -103,6 +111,12 @@ impl Simulation {
         }
         let t_end = self.scene.time() + duration;
         self.check_run(t_end)?;
+        self.control.begin_run();
+        if t_end > self.scene.time() {
+            for (kind, note) in self.scene.cost_notices() {
+                self.control.notice(kind, &note);
+            }
+        }
         loop {
             // Stop where a recorder wants a row, so nothing is evaluated between rows.
             let now = self.scene.time();
@@ -154,6 +168,19 @@ impl Simulation {
         self.recorders
             .iter_mut()
             .try_for_each(|r| r.fire(&self.scene, end_of_run, &mut probe))
+    }
+
+    /// What the integrator in use runs on this scene ([`Scene::integrator_info`]), and what the
+    /// last run's stepper did that its name does not say (stroboscopic averaging that fell back
+    /// to direct integration, and why).
+    pub fn integrator_info(&self) -> Result<String> {
+        let info = self.scene.integrator_info()?;
+        Ok(
+            match self.workspace.stepper_report(self.scene.integrator()) {
+                Some(r) => format!("{info}; in the last run: {r}"),
+                None => info,
+            },
+        )
     }
 
     /// Which backend the next run uses and why (see [`plan::backend_info`]).

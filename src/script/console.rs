@@ -1,7 +1,8 @@
 //! Text that script functions write themselves (a text plot), to standard output or to a front
 //! end's own sink (a notebook's stdout stream); values shown by `display(value)`, as text or
-//! through a front end's display sink (a notebook shows a picture inline). Rhai's `print` goes
-//! through the session's `on_print`, which a notebook points at the same stream.
+//! through a front end's display sink (a notebook shows a picture inline); notes a run gives
+//! while it goes on, to standard error or a front end's note sink. Rhai's `print` goes through
+//! the session's `on_print`, which a notebook points at the same stream.
 
 use std::io::Write;
 use std::sync::{Arc, Mutex};
@@ -52,6 +53,28 @@ static DISPLAY: Hook<DisplaySink> = Hook::new();
 /// Show `display(value)` values through `sink` (or as text again, given `None`).
 pub fn set_display_sink(sink: Option<DisplaySink>) {
     DISPLAY.set(sink);
+}
+
+static NOTE: Hook<TextSink> = Hook::new();
+
+/// Send notes (what a run says while it goes on) to `sink` (or standard error again, given
+/// `None`).
+pub fn set_note_sink(sink: Option<TextSink>) {
+    NOTE.set(sink);
+}
+
+/// Tell the user `text` as a note ("note: ..." on standard error, or a front end's note sink):
+/// not a result, so never on standard output, where it would mix with a script's own output.
+pub fn note(text: &str) {
+    let line = format!("note: {text}\n");
+    match NOTE.get() {
+        Some(f) => f(&line),
+        None => {
+            let mut err = std::io::stderr().lock();
+            let _ = err.write_all(line.as_bytes());
+            let _ = err.flush();
+        }
+    }
 }
 
 /// Show `v` now: through the display sink, else as the shell shows values.

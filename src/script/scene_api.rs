@@ -31,6 +31,9 @@ impl SceneHandle {
     pub fn new(scene: Scene) -> Self {
         let mut sim = Simulation::new(scene);
         sim.set_interrupt(Some(Arc::new(interrupt::requested)));
+        sim.set_notice(Some(Arc::new(|e: &crate::engine::EngineError| {
+            super::console::note(&super::engine_message(e))
+        })));
         SceneHandle(Arc::new(RwLock::new(sim)))
     }
 
@@ -458,6 +461,14 @@ pub fn register(engine: &mut Engine) {
             m.insert("macro_steps".into(), (st.macro_steps as INT).into());
             m.insert("micro_periods".into(), (st.micro_periods as INT).into());
             m.insert("noisy_steps".into(), (st.noisy_steps as INT).into());
+            m.insert(
+                "direct_fallbacks".into(),
+                (st.direct_fallbacks as INT).into(),
+            );
+            m.insert(
+                "fallback_periods".into(),
+                (st.fallback_periods as INT).into(),
+            );
             m
         })
         .register_fn(
@@ -495,7 +506,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
     doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
     doc_entry!("diffusion", "thermal", "s.diffusion(i) -> map", "Swimmer i's diffusion as a rigid dumbbell of length ell at the scene's temperature and mobility: parallel and perpendicular translation D_par, D_perp (m^2/s), their orientation average translation = (D_par + 2 D_perp)/3 (a centre's mean squared displacement grows as 6 translation t), rotation D_r (1/s), and offset: where along N from R_H translation and rotation decouple (m). All zero at 0 K. The averaged model's noise; for a symmetric dumbbell translation equals kT/(12 pi mu)(1/a + 1/ell).", "let s = scene(); s.add(dumbbell()); s.temperature = 300; print(s.diffusion(0).translation);"),
-    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations; macro_steps and micro_periods of stroboscopic averaging; noisy_steps, the steps taken with thermal noise (also the noise generator's counter).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
+    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations; macro_steps and micro_periods of stroboscopic averaging, and direct_fallbacks and fallback_periods, the times its macro steps failed at their shortest length and the periods it then integrated directly (s.integrator_info says why); noisy_steps, the steps taken with thermal noise (also the noise generator's counter).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
     doc_entry!("sphere_velocities", "reading", "s.sphere_velocities(forces) -> [[vx, vy, vz], ...]", "Sphere velocities (m/s) for given forces (N): one [fx, fy, fz] per sphere, swimmer by swimmer, the a1 sphere first; the scene's mobility and viscosity at the present sphere positions, Stokes drag included. For checks against other codes; the scene does not move.", "let s = scene(); s.add(dumbbell()); print(s.sphere_velocities([[1e-12, 0, 0], [0, 0, 0]]));"),
     doc_entry!("center", "reading", "s.center(i) -> [x, y, z]", "Hydrodynamic centre R_H of swimmer i (m).", "let s = scene(); s.add(dumbbell()); print(s.center(0));"),
     doc_entry!("dir", "reading", "s.dir(i) -> [x, y, z]", "Unit orientation N of swimmer i (from the a1 sphere to the a2 sphere).", "let s = scene(); s.add(dumbbell(#{ dir: [0, 1, 0] })); print(s.dir(0));"),
