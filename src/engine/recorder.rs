@@ -280,10 +280,24 @@ impl Recorder {
     /// Stream rows to `path` as CSV from now on: the file is created with the header and every
     /// row taken so far, then each new row is appended (one whole line, unbuffered) as it is
     /// taken. A kill loses no row already recorded; a later `stream_csv` moves the stream.
-    pub fn stream_csv(&mut self, path: &std::path::Path) -> Result<()> {
+    /// `retiring` is the owner's flag ([`super::files::Claim::take`]).
+    pub fn stream_csv(
+        &mut self,
+        path: &std::path::Path,
+        retiring: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ) -> Result<()> {
         let mut lines = vec![csv_line(self.header())];
         lines.extend(self.rows.iter().map(|r| csv_line(r.iter().map(f64_field))));
-        self.stream = Some(LineStream::create(path, &lines)?);
+        // Moved onto the file it writes already: that claim is this recorder's own.
+        if self.stream.as_ref().is_some_and(|s| s.is_at(path)) {
+            self.stream = None;
+        }
+        self.stream = Some(LineStream::create(
+            path,
+            &lines,
+            "a recorder's CSV stream",
+            retiring,
+        )?);
         Ok(())
     }
 

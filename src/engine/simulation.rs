@@ -13,6 +13,8 @@ use super::recorder::{Recorder, Trigger};
 use super::scene::Scene;
 use super::stepping::{Interrupt, Notice, Progress, RunControl, Workspace};
 use nalgebra::Vector3;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// A scene and what runs it. See the [module docs](self).
 #[derive(Debug, Default)]
@@ -22,6 +24,8 @@ pub struct Simulation {
     workspace: Workspace,
     probes: Workspace,
     control: RunControl,
+    /// Whether this simulation is being replaced: its recorders' files may be taken over.
+    retiring: Arc<AtomicBool>,
 }
 
 impl std::ops::Deref for Simulation {
@@ -65,6 +69,13 @@ impl Simulation {
     /// The scene, the rest dropped.
     pub fn into_scene(self) -> Scene {
         self.scene
+    }
+
+    /// Mark this simulation as being replaced (a shell input declares its variable anew) or no
+    /// longer: while it is, a new writer on a file one of its recorders writes takes that file
+    /// over, and the recorder writes it no more ([`super::files::Claim`]).
+    pub fn set_retiring(&self, retiring: bool) {
+        self.retiring.store(retiring, Ordering::SeqCst);
     }
 
     /// Stop runs (and probes) at a step boundary when `interrupt()` says so (`None`: never).
@@ -217,7 +228,7 @@ impl Simulation {
     /// recorder that writes it (its rows are the frames' times).
     pub fn trajectory(&mut self, path: &std::path::Path, trigger: Trigger) -> Result<usize> {
         trigger.validate()?;
-        let t = super::trajectory::Trajectory::create(path)?;
+        let t = super::trajectory::Trajectory::create(path, Some(self.retiring.clone()))?;
         let mut probe = Probe::new(&mut self.probes, &self.control);
         let r = Recorder::start_trajectory(&self.scene, t, trigger, &mut probe)?;
         Ok(self.add_recorder(r))
@@ -234,6 +245,12 @@ impl Simulation {
         self.recorders
             .get(id)
             .ok_or_else(|| invalid!("recorder {id} does not belong to this scene"))
+    }
+
+    /// Stream the rows of recorder `id` to `path` as CSV from now on (see [`Recorder::stream_csv`]).
+    pub fn stream_csv(&mut self, id: usize, path: &std::path::Path) -> Result<()> {
+        let retiring = self.retiring.clone();
+        self.recorder_mut(id)?.stream_csv(path, Some(retiring))
     }
 
     /// A recorder by id, to change (e.g. to stream its rows).
