@@ -260,3 +260,45 @@ fn one_writer_per_file() {
         assert!(lines[6 * f + 1].contains("Properties="), "{xyz}");
     }
 }
+
+/// A box or a position that wrapping cannot carry is refused with the reach positions may have
+/// (1e8 sphere radii), and the scene is unchanged; an elongated box the Ewald sums cannot take is
+/// refused at the run with settings that exist.
+#[test]
+fn boxes_and_positions_that_wrapping_cannot_carry_are_refused() {
+    let t = case(
+        &format!("{PAIR}s.box = [1e-4, 1e-4, 1e-4];\ntry {{ s.add_at(dumbbell(), [[1e308, 0, 0]]); }} catch (e) {{ print(e); }}\nprint(s.count);\nprint(s.observe(min_gap()));"),
+        &["beyond the 75 m from the origin that positions may reach", "1e8 times the smallest sphere radius"],
+        0,
+    );
+    let lines: Vec<&str> = t.lines().collect();
+    assert_eq!(lines[1], "2", "{t}");
+    assert!(lines[2].parse::<f64>().unwrap() > 0.0, "{t}");
+    let t = case(
+        &format!("{PAIR}try {{ s.box = [1e308, 1e-4, 1e-4]; }} catch (e) {{ print(e); }}\nprint(type_of(s.box));"),
+        &["the box side along x, 1e308 m, is longer than the 75 m"],
+        0,
+    );
+    assert!(t.trim_end().ends_with("()"), "still no box: {t}");
+    case(
+        "let s = scene();\ns.box = [1e200, 1e200, 1e-4];",
+        &["a volume f64 cannot hold"],
+        1,
+    );
+    case(
+        "let s = scene();\ns.box = [1e308, 1e-4, 1e-4];\ns.add(dumbbell());",
+        &["the box side along x, 1e308 m"],
+        1,
+    );
+    case(
+        "let s = scene();\ns.add(dumbbell(#{ center: [1e20, 0, 0] }));",
+        &["a swimmer's centre at x = 1e20 m"],
+        1,
+    );
+    let t = case(
+        "let s = scene();\ns.add(dumbbell());\ns.box = [70, 1e-4, 1e-4];\ns.run_periods(0.01);",
+        &["the box is too elongated", "s.model = \"averaged\""],
+        1,
+    );
+    assert!(!t.contains("splitting"), "{t}");
+}

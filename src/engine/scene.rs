@@ -60,6 +60,70 @@ fn lcm(a: u64, b: u64) -> u64 {
 }
 
 /// Swimmer `d` must not reach its own image: the box's shortest side above 2(ℓ + λ + a1 + a2).
+/// How far from the origin a swimmer's centre, and how long a box side, may reach, in units of
+/// the scene's smallest sphere radius. A coordinate carries an error of an ulp (2.2e-16 of
+/// itself) into every separation, minimum image and wrapped position, so at this reach a sphere
+/// is still resolved to 2.2e-8 of its radius; far beyond, spheres merge (a dumbbell at 1e20 m has
+/// both at one point) and wrapping returns NaN.
+pub const MAX_EXTENT_IN_RADII: f64 = 1e8;
+
+/// `x` to three significant digits, as a reader takes it in: "75", "7.5e-7".
+fn short(x: f64) -> String {
+    let r: f64 = format!("{x:.2e}").parse().unwrap_or(x);
+    if (1e-3..1e6).contains(&r.abs()) {
+        format!("{r}")
+    } else {
+        format!("{r:e}")
+    }
+}
+
+/// The reach [`MAX_EXTENT_IN_RADII`] of swimmers `ds` (m), with the smallest radius; `None` without
+/// swimmers.
+fn extent_limit<'a>(ds: impl IntoIterator<Item = &'a Dumbbell>) -> Option<(f64, f64)> {
+    let r = ds.into_iter().map(|d| d.a1.min(d.a2)).reduce(f64::min)?;
+    Some((MAX_EXTENT_IN_RADII * r, r))
+}
+
+/// Refuse a swimmer centre that the scene's positions cannot carry ([`MAX_EXTENT_IN_RADII`]).
+fn check_center<'a>(
+    center: &Vector3<f64>,
+    ds: impl IntoIterator<Item = &'a Dumbbell>,
+) -> Result<()> {
+    let Some((limit, r)) = extent_limit(ds) else {
+        return Ok(());
+    };
+    for (k, c) in ["x", "y", "z"].iter().zip(center.iter()) {
+        if c.abs() > limit {
+            return Err(invalid!(
+                "a swimmer's centre at {k} = {c:e} m is beyond the {} m from the origin that positions may reach ({MAX_EXTENT_IN_RADII:e} times the smallest sphere radius, {} m): there f64 no longer resolves the spheres (separations, minimum images and wrapped positions err by more than {:.0e} of a radius); place it within {} m of the origin",
+                short(limit),
+                short(r),
+                MAX_EXTENT_IN_RADII * f64::EPSILON,
+                short(limit)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuse a box whose sides the scene's positions cannot carry ([`MAX_EXTENT_IN_RADII`]).
+fn check_box_extent<'a>(b: &PeriodicBox, ds: impl IntoIterator<Item = &'a Dumbbell>) -> Result<()> {
+    let Some((limit, r)) = extent_limit(ds) else {
+        return Ok(());
+    };
+    for (k, l) in ["x", "y", "z"].iter().zip(b.sides()) {
+        if l > limit {
+            return Err(invalid!(
+                "the box side along {k}, {l:e} m, is longer than the {} m that positions may reach ({MAX_EXTENT_IN_RADII:e} times the smallest sphere radius, {} m): across it f64 no longer resolves the spheres, and wrapping cannot carry them; give sides up to {} m, or no box for open space",
+                short(limit),
+                short(r),
+                short(limit)
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn check_fits_box(d: &Dumbbell, b: &PeriodicBox) -> Result<()> {
     let reach = d.ell + d.lambda + d.a1 + d.a2;
     if b.shortest() <= 2.0 * reach {
@@ -224,8 +288,10 @@ impl Scene {
             require_finite(&format!("center.{k}"), *c)?;
         }
         let n = unit_direction(dir)?;
+        check_center(&center, self.swimmers.iter().chain([d]))?;
         if let Some(b) = &self.periodic {
             check_fits_box(d, b)?;
+            check_box_extent(b, self.swimmers.iter().chain([d]))?;
         }
         let (x1, x2) = d.sphere_positions(center, n, self.contact_length(d));
         for (s, other) in self.swimmers.iter().enumerate() {
@@ -233,7 +299,7 @@ impl Scene {
             for (xa, aa) in [(x1, d.a1), (x2, d.a2)] {
                 for (yb, ab) in [(y1, other.a1), (y2, other.a2)] {
                     let gap = separation(self.periodic.as_ref(), xa - yb).norm() - aa - ab;
-                    if gap <= margin {
+                    if !(gap > margin) {
                         return Err(invalid!(
                             "the new swimmer would overlap swimmer {s} (sphere gap {gap:.3e} m); place its centre further away"
                         ));
@@ -356,6 +422,7 @@ impl Scene {
         for (i, d) in self.swimmers.iter().enumerate() {
             check_fits_box(d, &b).map_err(|e| invalid!("swimmer {i}: {e}"))?;
         }
+        check_box_extent(&b, &self.swimmers)?;
         let old = self.periodic.replace(b);
         if let Some((gap, a, c)) = self.closest_spheres() {
             if gap <= 0.0 && !(self.contacts.allow_overlap && a / 2 != c / 2) {

@@ -208,8 +208,12 @@ fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult
     let mut trial = s.borrow().scene().clone();
     for (k, c) in centres.iter().enumerate() {
         let c = super::convert::vector3(&format!("add_at: centre {k}"), c)?;
-        lift(trial.add(d.params, c, d.dir))
-            .map_err(|e| script_error(format!("add_at: centre {k}: {e}")))?;
+        trial.add(d.params, c, d.dir).map_err(|e| {
+            script_error(format!(
+                "add_at: centre {k}: {}",
+                super::convert::engine_message(&e)
+            ))
+        })?;
     }
     Ok(s.replace(trial))
 }

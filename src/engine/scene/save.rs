@@ -138,6 +138,13 @@ impl Scene {
             ));
         }
         for i in 0..self.count() {
+            super::check_center(&self.center(i)?, &self.swimmers)
+                .map_err(|e| invalid!("swimmer {i}: {e}"))?;
+        }
+        if let Some(b) = &self.periodic {
+            super::check_box_extent(b, &self.swimmers)?;
+        }
+        for i in 0..self.count() {
             let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
             let len = v.norm();
             match self.model {
