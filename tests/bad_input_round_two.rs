@@ -302,3 +302,51 @@ fn boxes_and_positions_that_wrapping_cannot_carry_are_refused() {
     );
     assert!(!t.contains("splitting"), "{t}");
 }
+
+/// A scene every call of a sweep reaches (captured by the closure, or in two parameters) may be
+/// read by the calls, not changed: changed from several threads at once, its results changed from
+/// run to run. Reading it, copying it and running the copies, and scenes of their own are fine,
+/// and the same every time.
+#[test]
+fn sweeps_do_not_race_on_a_shared_scene() {
+    let t = case(
+        &format!("{PAIR}sweep([1, 2, 3, 4], |p| {{ s.run_periods(0.01); s.time }}, 4);"),
+        &[
+            "sweep: the call for parameter 0 (1) failed: in the closure: this scene is shared by every call of the sweep",
+            "let t = s.copy()",
+        ],
+        1,
+    );
+    assert!(!t.contains("anon$") && !t.contains("Runtime error"), "{t}");
+    case(
+        &format!("{PAIR}sweep([s, s], |x| {{ x.mu = 2e-3; }});"),
+        &["shared by every call of the sweep"],
+        1,
+    );
+    case(
+        &format!("{PAIR}let r = s.record([R_H(0)], 1);\nsweep([1, 2], |p| {{ r.stream_csv(`r${{p}}.csv`); }});"),
+        &["shared by every call of the sweep"],
+        1,
+    );
+    let script = format!(
+        "{PAIR}print(sweep([1, 2, 3, 4], |p| {{ let t = s.copy(); t.run_periods(0.01 * p); t.time / t.period }}, 4));\nprint(sweep([1, 2], |p| s.observe(R_H(p - 1))[0]));\nlet a = s.copy();\nlet b = s.copy();\nprint(sweep([a, b], |x| {{ x.run_periods(0.01); x.count }}));\ns.run_periods(0.01);\nprint(s.time > 0.0);"
+    );
+    let first = case(&script, &[], 0);
+    let lines: Vec<&str> = first.lines().collect();
+    let periods: Vec<f64> = lines[0]
+        .trim_matches(|c| c == '[' || c == ']')
+        .split(", ")
+        .map(|x| x.parse().unwrap())
+        .collect();
+    // Each copy ran 0.01 p periods from time 0 (to rounding of the period's multiples).
+    for (k, p) in periods.iter().enumerate() {
+        assert!((p - 0.01 * (k + 1) as f64).abs() < 1e-12, "{first}");
+    }
+    assert_eq!(lines[1], "[-2.5e-5, 2.5e-5]", "{first}");
+    assert_eq!(lines[2], "[2, 2]", "{first}");
+    assert_eq!(
+        lines[3], "true",
+        "the scene is free again after the sweep: {first}"
+    );
+    assert_eq!(case(&script, &[], 0), first, "the same every time");
+}

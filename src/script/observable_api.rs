@@ -11,7 +11,7 @@ use rhai::{Array, Dynamic, Engine, ImmutableString, Map, INT};
 /// A script's handle on one recorder of a scene.
 #[derive(Debug, Clone)]
 pub struct RecorderHandle {
-    scene: SceneHandle,
+    pub(super) scene: SceneHandle,
     id: usize,
 }
 
@@ -161,7 +161,7 @@ pub fn register(engine: &mut Engine) {
         .register_fn(
             "observe",
             |s: &mut SceneHandle, o: Observable| -> ScriptResult<Dynamic> {
-                lift(s.borrow_mut().measure(&o)).map(value)
+                lift(s.borrow_to_measure().measure(&o)).map(value)
             },
         );
 
@@ -191,7 +191,7 @@ pub fn register(engine: &mut Engine) {
             |s: &mut SceneHandle, list: Array, every: Dynamic| -> ScriptResult<RecorderHandle> {
                 let obs = observables_of(&list)?;
                 let trigger = trigger_of(&every)?;
-                let id = lift(s.borrow_mut().record(obs, trigger))?;
+                let id = lift(s.borrow_mut()?.record(obs, trigger))?;
                 Ok(RecorderHandle {
                     scene: s.clone(),
                     id,
@@ -206,7 +206,7 @@ pub fn register(engine: &mut Engine) {
              -> ScriptResult<RecorderHandle> {
                 let trigger = trigger_of(&every)?;
                 let id = lift(
-                    s.borrow_mut()
+                    s.borrow_mut()?
                         .trajectory(std::path::Path::new(path.as_str()), trigger),
                 )?;
                 Ok(RecorderHandle {
@@ -266,7 +266,7 @@ pub fn register(engine: &mut Engine) {
             |r: &mut RecorderHandle, path: &str| -> ScriptResult<()> {
                 lift(
                     r.scene
-                        .borrow_mut()
+                        .borrow_mut()?
                         .stream_csv(r.id, std::path::Path::new(path)),
                 )
             },

@@ -310,7 +310,7 @@ fn animate(s: &mut SceneHandle, path: &str, opts: &Map) -> ScriptResult<INT> {
             // Frame k at t0 + k/frames of the run: no rounding accumulates over the frames.
             let target = t0 + duration * k as f64 / frames as f64;
             let now = s.borrow().time();
-            lift(s.borrow_mut().run((target - now).max(0.0)))?;
+            lift(s.borrow_mut()?.run((target - now).max(0.0)))?;
         }
         film.frame(&s.borrow())
             .map_err(|e| script_error(format!("animate \"{path}\": {e}")))?;

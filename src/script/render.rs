@@ -33,6 +33,12 @@ pub fn render_error(name: &str, source: &str, err: &EvalAltResult) -> String {
     out
 }
 
+/// The message of `err` as [`render_error`] words it, without its position (for an error quoted
+/// inside another's message).
+pub fn message_of(err: &EvalAltResult) -> String {
+    super::types::in_words(&describe(err).msg)
+}
+
 /// The source line and a caret under column `col` (1-based, counted in characters as Rhai does).
 fn excerpt(source: &str, line: usize, col: usize) -> String {
     let Some(text) = source.lines().nth(line - 1) else {
@@ -78,7 +84,12 @@ fn describe(err: &EvalAltResult) -> Described {
     match err {
         EvalAltResult::ErrorInFunctionCall(f, src, inner, pos) => {
             let d = describe(inner);
-            let f = f.as_str();
+            // A closure's function has a generated name ("anon$5f3c..."), which says nothing.
+            let f = if f.starts_with("anon$") {
+                "the closure"
+            } else {
+                f.as_str()
+            };
             if !src.is_empty() && src != "<input>" {
                 // The inner position is in the module `src`; the user's position is the call.
                 let module = d.module.or_else(|| Some((src.clone(), d.pos)));

@@ -11,6 +11,7 @@ use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
 use crate::engine::{Backend, Scene, Simulation};
 use rhai::{Array, Dynamic, Engine, INT};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 /// The largest scene file `load_scene` reads (bytes): a saved scene of 10^5 swimmers is ~60 MB.
@@ -18,7 +19,23 @@ pub const MAX_SCENE_FILE_BYTES: u64 = 256 << 20;
 
 /// A script's handle on a scene and its simulation (Rhai type `Scene`).
 #[derive(Debug, Clone)]
-pub struct SceneHandle(pub Arc<RwLock<Simulation>>);
+pub struct SceneHandle {
+    sim: Arc<RwLock<Simulation>>,
+    /// The sweeps whose calls share this scene now: while any does, it can be read, not changed.
+    shared_by_sweeps: Arc<AtomicUsize>,
+}
+
+/// While this lives, the scenes it holds are shared by the calls of a sweep (see
+/// [`SceneHandle::borrow_mut`]).
+pub(super) struct SweepShare(Vec<SceneHandle>);
+
+impl Drop for SweepShare {
+    fn drop(&mut self) {
+        for h in &self.0 {
+            h.shared_by_sweeps.fetch_sub(1, Ordering::SeqCst);
+        }
+    }
+}
 
 impl Default for SceneHandle {
     fn default() -> Self {
@@ -34,18 +51,51 @@ impl SceneHandle {
         sim.set_notice(Some(Arc::new(|e: &crate::engine::EngineError| {
             super::console::note(&super::engine_message(e))
         })));
-        SceneHandle(Arc::new(RwLock::new(sim)))
+        SceneHandle {
+            sim: Arc::new(RwLock::new(sim)),
+            shared_by_sweeps: Arc::default(),
+        }
+    }
+
+    /// Whether `other` is a handle on the same scene.
+    pub(super) fn same(&self, other: &SceneHandle) -> bool {
+        Arc::ptr_eq(&self.sim, &other.sim)
+    }
+
+    /// Mark `scenes` as shared by the calls of a sweep for as long as the result lives.
+    pub(super) fn share_in_sweep(scenes: Vec<SceneHandle>) -> SweepShare {
+        for h in &scenes {
+            h.shared_by_sweeps.fetch_add(1, Ordering::SeqCst);
+        }
+        SweepShare(scenes)
     }
 
     /// Read the simulation (and through it the scene). A lock poisoned by a panic elsewhere still
     /// holds a consistent one (every change is made whole or not at all), so it is read anyway.
     pub fn borrow(&self) -> RwLockReadGuard<'_, Simulation> {
-        self.0.read().unwrap_or_else(|e| e.into_inner())
+        self.sim.read().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Change the simulation.
-    pub fn borrow_mut(&self) -> RwLockWriteGuard<'_, Simulation> {
-        self.0.write().unwrap_or_else(|e| e.into_inner())
+    /// Change the simulation; refused while the calls of a sweep share the scene: they run at once
+    /// on several threads, and changes from them would race (results changing from run to run).
+    pub fn borrow_mut(&self) -> ScriptResult<RwLockWriteGuard<'_, Simulation>> {
+        if self.shared_by_sweeps.load(Ordering::SeqCst) > 0 {
+            return Err(script_error(
+                "this scene is shared by every call of the sweep (captured by its closure, or given in more than one parameter), and the calls run at once on several threads: changing it from them would race, and the results would change from run to run; a call may read it, not change it: build the scene inside the closure, or change a copy there (let t = s.copy(); t.run_periods(1); ...)",
+            ));
+        }
+        Ok(self.write())
+    }
+
+    /// The simulation to measure with (a probe runs copies, and keeps its buffers in the
+    /// simulation): a reading, allowed while a sweep shares the scene; the lock keeps the calls'
+    /// measurements one at a time.
+    pub(super) fn borrow_to_measure(&self) -> RwLockWriteGuard<'_, Simulation> {
+        self.write()
+    }
+
+    fn write(&self) -> RwLockWriteGuard<'_, Simulation> {
+        self.sim.write().unwrap_or_else(|e| e.into_inner())
     }
 
     pub(super) fn with<T>(
@@ -60,22 +110,22 @@ impl SceneHandle {
         &self,
         f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
-        lift(f(self.borrow_mut().scene_mut()))
+        lift(f(self.borrow_mut()?.scene_mut()))
     }
 
-    /// Run or measure.
+    /// Run.
     fn with_sim<T>(
         &self,
         f: impl FnOnce(&mut Simulation) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
-        lift(f(&mut self.borrow_mut()))
+        lift(f(&mut *self.borrow_mut()?))
     }
 
     /// Put `trial` in place of the scene (the recorders stay); returns the new count.
-    fn replace(&self, trial: Scene) -> INT {
-        let mut sim = self.borrow_mut();
+    fn replace(&self, trial: Scene) -> ScriptResult<INT> {
+        let mut sim = self.borrow_mut()?;
         sim.replace_scene(trial);
-        sim.count() as INT
+        Ok(sim.count() as INT)
     }
 }
 
@@ -199,7 +249,7 @@ fn add_random(
         seed as u64,
         gap,
     ))?;
-    Ok(s.replace(trial))
+    s.replace(trial)
 }
 
 /// `s.add_at(d, centres)`: a copy of d (its orientation and phase) at every centre of the array,
@@ -215,7 +265,7 @@ fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult
             ))
         })?;
     }
-    Ok(s.replace(trial))
+    s.replace(trial)
 }
 
 /// Run `f` with a progress bar over the next `duration` seconds (only at a terminal).

@@ -73,7 +73,7 @@ fn register_choice<T: Named + Send + Sync>(
                 let name = string_arg(property, &v)?;
                 let value = lift(choice::parse::<T>(&name))?;
                 check(value)?;
-                set(s.borrow_mut().scene_mut(), value);
+                set(s.borrow_mut()?.scene_mut(), value);
                 Ok(())
             },
         );
@@ -168,7 +168,7 @@ pub fn register(engine: &mut Engine) {
                             describe(&v)
                         ))
                     })?;
-                s.borrow_mut().scene_mut().set_seed(seed);
+                s.borrow_mut()?.scene_mut().set_seed(seed);
                 Ok(())
             },
         )
@@ -209,7 +209,7 @@ pub fn register(engine: &mut Engine) {
             None => Dynamic::UNIT,
         })
         .register_set("steric", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-            s.borrow_mut().scene_mut().set_steric(steric_arg(&v)?);
+            s.borrow_mut()?.scene_mut().set_steric(steric_arg(&v)?);
             Ok(())
         })
         .register_get("cutoff", |s: &mut SceneHandle| {
@@ -245,12 +245,12 @@ pub fn register(engine: &mut Engine) {
             "integrator",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 if let Some(spec) = v.clone().try_cast::<IntegratorSpec>() {
-                    s.borrow_mut().scene_mut().set_integrator(Some(spec));
+                    s.borrow_mut()?.scene_mut().set_integrator(Some(spec));
                     return Ok(());
                 }
                 match v.clone().into_immutable_string() {
                     Ok(name) if name == "default" => {
-                        s.borrow_mut().scene_mut().set_integrator(None);
+                        s.borrow_mut()?.scene_mut().set_integrator(None);
                         Ok(())
                     }
                     Ok(name) => match METHODS.iter().find(|m| m.name == name.as_str()) {

@@ -109,14 +109,18 @@ pub fn describe(v: &Dynamic) -> String {
     if v.is_unit() {
         return "()".into();
     }
+    format!("{} ({})", quote(v), type_word(v))
+}
+
+/// A value as a message quotes it: its text as the shell shows it, shortened.
+pub fn quote(v: &Dynamic) -> String {
     let text = super::show(v);
-    let text = if text.chars().count() > QUOTED_CHARS {
+    if text.chars().count() > QUOTED_CHARS {
         let cut: String = text.chars().take(QUOTED_CHARS).collect();
         format!("{cut}…")
     } else {
         text
-    };
-    format!("{text} ({})", type_word(v))
+    }
 }
 
 /// `msg` with every Rust type path of a script type (and Rhai's string type spellings) in
