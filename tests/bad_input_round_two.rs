@@ -350,3 +350,53 @@ fn sweeps_do_not_race_on_a_shared_scene() {
     );
     assert_eq!(case(&script, &[], 0), first, "the same every time");
 }
+
+/// Pictures, animations and fields written where no file can be made get the message every file
+/// writer gives: the path, the cause and the fix, never the drawing library's debug text.
+#[test]
+fn pictures_name_the_path_they_cannot_write() {
+    for (call, path) in [
+        (
+            "plot(\"/proc/x.png\", #{ x: [1, 2], y: [1, 2] });",
+            "/proc/x.png",
+        ),
+        (
+            "plot(\"/proc/x.svg\", #{ x: [1, 2], y: [1, 2] });",
+            "/proc/x.svg",
+        ),
+        ("s.snapshot(\"/proc/x.png\");", "/proc/x.png"),
+        (
+            "s.animate(\"/proc/x.gif\", #{ frames: 2, periods: 0.1 });",
+            "/proc/x.gif",
+        ),
+        ("s.field(\"density\").plot(\"/proc/x.png\");", "/proc/x.png"),
+        (
+            "plot(#{ x: [1, 2], y: [1, 2] }).save(\"/proc/x.png\");",
+            "/proc/x.png",
+        ),
+    ] {
+        case(
+            &format!("{PAIR}{call}"),
+            &[
+                &format!("cannot write {path}: No such file or directory"),
+                "check that the folder is writable",
+            ],
+            1,
+        );
+    }
+    let d = case_dir();
+    let out = run_in(
+        &format!("{PAIR}print(s.animate(\"a.gif\", #{{ frames: 3, periods: 0.1 }}));"),
+        &d,
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let decoder = gif::DecodeOptions::new();
+    let mut r = decoder
+        .read_info(std::fs::File::open(d.join("a.gif")).unwrap())
+        .unwrap();
+    let mut frames = 0;
+    while r.read_next_frame().unwrap().is_some() {
+        frames += 1;
+    }
+    assert_eq!(frames, 4, "the snapshot now and after each of 3 slices");
+}

@@ -135,6 +135,27 @@ pub fn ensure_parent(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Create (or truncate) the file `path` for writing, its folder created, with errors that name
+/// the path and the fix.
+pub fn create(path: &Path) -> Result<std::fs::File> {
+    if path.as_os_str().is_empty() {
+        return Err(invalid!(
+            "cannot write a file with an empty name; give a path such as \"out/run.csv\""
+        ));
+    }
+    ensure_parent(path)?;
+    if path.is_dir() {
+        return Err(invalid!(
+            "cannot write {}: it is a folder; give a file name",
+            path.display()
+        ));
+    }
+    if let Some(h) = holder(path) {
+        return Err(held_error(path, &h));
+    }
+    std::fs::File::create(path).map_err(|e| write_error(path, e))
+}
+
 fn write_error(path: &Path, e: std::io::Error) -> super::error::EngineError {
     invalid!(
         "cannot write {}: {e}; check that the folder is writable and the disk not full",
