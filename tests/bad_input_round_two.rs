@@ -400,3 +400,41 @@ fn pictures_name_the_path_they_cannot_write() {
     }
     assert_eq!(frames, 4, "the snapshot now and after each of 3 slices");
 }
+
+/// The smaller items: a trajectory's row limit names the trajectory; CSV is not written under
+/// the name of another format (refused: a `.png` holding CSV opens in no picture viewer).
+#[test]
+fn row_limits_name_the_trajectory_and_csv_keeps_to_csv_names() {
+    let t = case(
+        &format!("{PAIR}s.trajectory(\"out/t.xyz\", every_seconds(1e-9));\ns.run_periods(1);"),
+        &["rows to the trajectory out/t.xyz (every 1e-9 s)"],
+        1,
+    );
+    assert!(!t.contains("recorder of  ("), "{t}");
+    case(
+        &format!("{PAIR}let r = s.record([], every_seconds(1e-12));\ns.run_periods(10);"),
+        &["rows to the recorder of times only"],
+        1,
+    );
+    for (call, ext) in [
+        ("r.to_csv(\"out/r.png\")", "png"),
+        ("r.stream_csv(\"out/r.gif\")", "gif"),
+        ("r.to_csv(\"out/r.VTI\")", "vti"),
+        ("write_csv(\"out/r.svg\", [#{ a: 1 }])", "svg"),
+    ] {
+        case(
+            &format!("{PAIR}let r = s.record([R_H(0)], 1);\n{call};"),
+            &[&format!("ends in .{ext}"), "give a name ending in .csv"],
+            1,
+        );
+    }
+    let d = case_dir();
+    let out = run_in(
+        &format!("{PAIR}let r = s.record([R_H(0)], 1);\nr.to_csv(\"r.csv\");\nr.to_csv(\"r.txt\");\nwrite_csv(\"w.dat\", [#{{ a: 1 }}]);"),
+        &d,
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    for f in ["r.csv", "r.txt", "w.dat"] {
+        assert!(d.join(f).is_file(), "{f}");
+    }
+}

@@ -135,6 +135,40 @@ pub fn ensure_parent(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// File name endings of formats other than CSV that swimlab writes or that programs open by their
+/// ending, with what they are.
+const NOT_CSV: &[(&str, &str)] = &[
+    ("png", "a PNG picture"),
+    ("svg", "an SVG picture"),
+    ("gif", "a GIF animation"),
+    ("jpg", "a JPEG picture"),
+    ("jpeg", "a JPEG picture"),
+    ("pdf", "a PDF document"),
+    ("vti", "VTK image data"),
+    ("vtp", "VTK poly data"),
+    ("vtk", "a VTK file"),
+    ("pvd", "a ParaView series"),
+    ("xyz", "an extended XYZ trajectory"),
+    ("json", "JSON (a saved scene)"),
+    ("rhai", "a script"),
+];
+
+/// Refuse writing CSV text to `path` when its name says another format (a `.png` that no picture
+/// viewer would open): `what` is the writer ("to_csv").
+pub fn check_csv_name(path: &Path, what: &str) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if let Some((e, format)) = ext.and_then(|x| NOT_CSV.iter().find(|(e, _)| *e == x)) {
+        return Err(invalid!(
+            "{what}: {} ends in .{e}, the name of {format}, but this writes CSV text that the programs opening .{e} files cannot read; give a name ending in .csv",
+            path.display()
+        ));
+    }
+    Ok(())
+}
+
 /// Create (or truncate) the file `path` for writing, its folder created, with errors that name
 /// the path and the fix.
 pub fn create(path: &Path) -> Result<std::fs::File> {

@@ -119,6 +119,11 @@ impl Trajectory {
         Ok(t)
     }
 
+    /// The trajectory's file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// Where the `.vtp` frames of a `.pvd` go: `<name>_frames/` beside it.
     fn frame_dir(&self) -> PathBuf {
         let stem = self
