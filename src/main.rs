@@ -153,6 +153,8 @@ enum BenchKind {
 }
 
 fn main() -> ExitCode {
+    // Before any thread starts: it may set an environment variable.
+    swimlab::script::quiet_device_selection();
     let cli = Cli::parse();
     let result = if let Some(expr) = cli.eval {
         swimlab::script::interrupt::install_batch_handler();
