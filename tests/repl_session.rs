@@ -157,3 +157,21 @@ fn a_cell_run_again_writes_its_trajectory_afresh() {
         other => panic!("{other:?}"),
     }
 }
+
+/// An input that fails before it declares a variable anew leaves the old one as it was (it was
+/// only set aside for the run); one that reads the variable in its own declaration keeps it too.
+#[test]
+fn a_failed_redeclaration_keeps_the_old_variable() {
+    let mut s = Session::new();
+    out(&mut s, "let sc = scene(); sc.add(dumbbell());");
+    assert!(matches!(
+        s.handle("let sc = load_scene(\"no/such/scene.json\");"),
+        Reply::Error(_)
+    ));
+    assert_eq!(out(&mut s, "sc.count"), "=> 1");
+    out(
+        &mut s,
+        "let sc = sc.copy(); sc.add(dumbbell(#{ center: [20e-6, 0, 0] }));",
+    );
+    assert_eq!(out(&mut s, "sc.count"), "=> 2");
+}

@@ -163,7 +163,8 @@ impl Session {
                 .iter_raw()
                 .filter(|(n, ..)| *n == name)
                 .map(|(_, c, _)| c)
-                .last()
+                // The newest of that name: the one the input hides.
+                .next()
             else {
                 continue;
             };
@@ -200,11 +201,13 @@ impl Session {
     /// more, and a scene among them would keep its memory, and its recorders the files they
     /// write.
     fn drop_shadowed(&mut self) {
-        let entries: Vec<(String, bool, Dynamic)> = self
+        // Oldest first (the scope iterates from the newest).
+        let mut entries: Vec<(String, bool, Dynamic)> = self
             .scope
             .iter_raw()
             .map(|(n, c, v)| (n.to_string(), c, v.clone()))
             .collect();
+        entries.reverse();
         let last = |k: usize| !entries[k + 1..].iter().any(|(n, ..)| *n == entries[k].0);
         if (0..entries.len()).all(last) {
             return;
