@@ -40,7 +40,9 @@ pub fn check_steps(s: &Scene, t_end: f64) -> Result<()> {
         return Ok(());
     }
     let latest = s.latest_time();
-    if !(t_end <= latest) {
+    // A NaN end is not within the latest time: refused as well.
+    let within = t_end <= latest;
+    if !within {
         let periods = |t: f64| {
             s.period()
                 .map_or(String::new(), |p| format!(" ({:.6e} periods)", t / p))

@@ -124,6 +124,12 @@ fn check_box_extent<'a>(b: &PeriodicBox, ds: impl IntoIterator<Item = &'a Dumbbe
     Ok(())
 }
 
+/// Two spheres `gap` apart (m, surface to surface) are clear of each other by more than
+/// `margin`; a NaN gap is not.
+fn clear(gap: f64, margin: f64) -> bool {
+    gap > margin
+}
+
 fn check_fits_box(d: &Dumbbell, b: &PeriodicBox) -> Result<()> {
     let reach = d.ell + d.lambda + d.a1 + d.a2;
     if b.shortest() <= 2.0 * reach {
@@ -299,7 +305,7 @@ impl Scene {
             for (xa, aa) in [(x1, d.a1), (x2, d.a2)] {
                 for (yb, ab) in [(y1, other.a1), (y2, other.a2)] {
                     let gap = separation(self.periodic.as_ref(), xa - yb).norm() - aa - ab;
-                    if !(gap > margin) {
+                    if !clear(gap, margin) {
                         return Err(invalid!(
                             "the new swimmer would overlap swimmer {s} (sphere gap {gap:.3e} m); place its centre further away"
                         ));

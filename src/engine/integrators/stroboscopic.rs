@@ -359,7 +359,7 @@ impl Stroboscopic {
         // Block b of v; an orientation block without its part along y's orientation.
         let part = |v: &[f64], b: usize| {
             let s = vec3(v, b);
-            if b % 2 == 0 {
+            if b.is_multiple_of(2) {
                 return s;
             }
             let o = vec3(y, b);
