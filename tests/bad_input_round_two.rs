@@ -234,24 +234,31 @@ fn a_costly_ewald_method_says_so_when_the_run_starts() {
 }
 
 /// Two trajectories on one path: the second is refused (the first keeps writing whole frames
-/// that ASE and OVITO read), and so is a stream or a whole-file write onto a trajectory's file.
+/// that ASE and OVITO read), and so is a whole-file write onto a trajectory's file (a CSV stream
+/// cannot reach one: CSV under a trajectory's name is refused first); two streams on one CSV
+/// file, and a whole-file write onto a stream's file, are refused the same way.
 #[test]
 fn one_writer_per_file() {
     let d = case_dir();
     let out = run_in(
-        &format!("{PAIR}s.trajectory(\"out/t.xyz\", 0.5);\ntry {{ s.trajectory(\"out/t.xyz\", 0.25); }} catch (e) {{ print(e); }}\nlet u = s.copy();\ntry {{ u.trajectory(\"out/../out/t.xyz\", 0.5); }} catch (e) {{ print(e); }}\nlet r = u.record([R_H(0)], 1);\ntry {{ r.stream_csv(\"out/t.xyz\"); }} catch (e) {{ print(e); }}\ntry {{ s.save(\"out/t.xyz\"); }} catch (e) {{ print(e); }}\ns.run_periods(1);"),
+        &format!("{PAIR}s.trajectory(\"out/t.xyz\", 0.5);\ntry {{ s.trajectory(\"out/t.xyz\", 0.25); }} catch (e) {{ print(e); }}\nlet u = s.copy();\ntry {{ u.trajectory(\"out/../out/t.xyz\", 0.5); }} catch (e) {{ print(e); }}\nlet r = u.record([R_H(0)], 1);\ntry {{ r.stream_csv(\"out/t.xyz\"); }} catch (e) {{ print(e); }}\ntry {{ s.save(\"out/t.xyz\"); }} catch (e) {{ print(e); }}\nr.stream_csv(\"out/r.csv\");\nlet q = s.record([R_H(0)], 1);\ntry {{ q.stream_csv(\"out/r.csv\"); }} catch (e) {{ print(e); }}\ntry {{ q.to_csv(\"out/r.csv\"); }} catch (e) {{ print(e); }}\ns.run_periods(1);"),
         &d,
     );
     let t = text(&out);
     assert_eq!(out.status.code(), Some(0), "{t}");
-    let refused = |start: &str| {
+    let refused = |start: &str, holder: &str| {
         t.lines()
-            .filter(|l| l.starts_with(start) && l.contains("is being written by a trajectory"))
+            .filter(|l| {
+                l.starts_with(start) && l.contains(&format!("is being written by {holder}"))
+            })
             .count()
     };
-    // The second trajectory, the stream and the save; the same file by another spelling.
-    assert_eq!(refused("out/t.xyz "), 3, "{t}");
-    assert_eq!(refused("out/../out/t.xyz "), 1, "{t}");
+    // The second trajectory and the save; the same file by another spelling.
+    assert_eq!(refused("out/t.xyz ", "a trajectory"), 2, "{t}");
+    assert_eq!(refused("out/../out/t.xyz ", "a trajectory"), 1, "{t}");
+    assert!(t.contains("stream_csv: out/t.xyz ends in .xyz"), "{t}");
+    // The second stream and the whole-file write.
+    assert_eq!(refused("out/r.csv ", "a recorder's CSV stream"), 2, "{t}");
     let xyz = std::fs::read_to_string(d.join("out/t.xyz")).unwrap();
     let lines: Vec<&str> = xyz.lines().collect();
     assert_eq!(lines.len(), 3 * 6, "three frames of 4 spheres: {xyz}");

@@ -413,8 +413,9 @@ fn kill_9_leaves_a_whole_paraview_series() {
     assert!(inside <= 1, "{inside} temporary files");
 }
 
-/// One writer per file: a second trajectory (or a CSV stream, or a whole-file write) on a path a
-/// trajectory of this process is writing is refused, and the first keeps whole frames.
+/// One writer per file: a second trajectory, or a whole-file write, on a path a trajectory of
+/// this process is writing is refused, and the first keeps whole frames. CSV cannot reach it: a
+/// CSV stream or file under a trajectory's name is refused for the name first.
 #[test]
 fn a_second_writer_on_a_trajectory_is_refused() {
     let d = dir("claim");
@@ -433,9 +434,14 @@ fn a_second_writer_on_a_trajectory_is_refused() {
         .record(Vec::new(), Trigger::EveryPeriods(1.0))
         .unwrap();
     let e = other.stream_csv(id, &path).unwrap_err();
-    assert!(e.to_string().contains("being written"), "{e}");
+    assert!(e.to_string().contains("ends in .xyz"), "{e}");
     let e = other.recorder(id).unwrap().write_csv(&path).unwrap_err();
-    assert!(e.to_string().contains("being written"), "{e}");
+    assert!(e.to_string().contains("ends in .xyz"), "{e}");
+    let e = swimlab::engine::files::write_atomically(&same, |w| w.write_all(b"x\n")).unwrap_err();
+    assert!(
+        e.to_string().contains("is being written by a trajectory"),
+        "{e}"
+    );
     sim.run_periods(1.0).unwrap();
     let (frames, whole) = whole_frames(&std::fs::read_to_string(&path).unwrap());
     assert_eq!((frames, whole), (3, true));
