@@ -160,7 +160,7 @@ fn main() -> ExitCode {
         swimlab::script::interrupt::install_batch_handler();
         swimlab::script::eval_expression(&expr).map(|shown| {
             if let Some(v) = shown {
-                println!("{v}");
+                swimlab::script::console::to_stdout(&format!("{v}\n"));
             }
         })
     } else {

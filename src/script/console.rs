@@ -89,10 +89,31 @@ pub fn display(v: &rhai::Dynamic) {
 pub fn write(text: &str) {
     match SINK.get() {
         Some(f) => f(text),
-        None => {
-            let mut out = std::io::stdout().lock();
-            let _ = out.write_all(text.as_bytes());
-            let _ = out.flush();
+        None => to_stdout(text),
+    }
+}
+
+/// The exit status of a process whose standard output was closed under it: the one a shell
+/// gives a process that SIGPIPE ended (128 + 13).
+pub const CLOSED_STDOUT_STATUS: i32 = 141;
+
+/// Write `text` to standard output, flushed. When its reader has gone (`swimlab run s.rhai |
+/// head -1`), nothing more written could be read: the process ends at once, quietly, with
+/// [`CLOSED_STDOUT_STATUS`], as command-line tools do (files written so far are whole: every
+/// writer renames or appends whole lines). Any other failure (a full disk) is told once on
+/// standard error; the script goes on, its printed text lost.
+pub fn to_stdout(text: &str) {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    static TOLD: AtomicBool = AtomicBool::new(false);
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(CLOSED_STDOUT_STATUS);
+        }
+        if !TOLD.swap(true, Ordering::SeqCst) {
+            note(&format!(
+                "cannot write standard output ({e}): what the script prints is lost; check where it is redirected"
+            ));
         }
     }
 }

@@ -36,6 +36,9 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     field_api::register(&mut engine);
     params::register_defaults(&mut engine);
     let embedded = stdlib::install(&mut engine);
+    // `print` as every other text a script writes: a closed standard output ends the process
+    // quietly (Rhai's own `println!` would panic).
+    engine.on_print(|s| super::console::to_stdout(&format!("{s}\n")));
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
     (engine, embedded)
