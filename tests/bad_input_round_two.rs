@@ -445,3 +445,20 @@ fn row_limits_name_the_trajectory_and_csv_keeps_to_csv_names() {
         assert!(d.join(f).is_file(), "{f}");
     }
 }
+
+/// A closure is shown as one, never by the generated name of its function ("anon$5f3c..."):
+/// printed, displayed, in a string, in an array or a map, quoted by a message, and when it is
+/// called with a number of arguments its parameters do not take.
+#[test]
+fn closures_are_named_as_such() {
+    let t = case(
+        "let f = |x| x + 1;\nprint(f);\ndisplay(f);\nprint(`${f}`);\nprint([f]);\nprint(#{ g: f });\ntry { scene().run(f); } catch (e) { print(e); }\nsweep([1, 2], |a, b| a);",
+        &[
+            "Fn(a closure)\nFn(a closure)\nFn(a closure)\n[Fn(a closure)]\n#{\"g\": Fn(a closure)}\n",
+            "got Fn(a closure) (Fn)",
+            "sweep: the call for parameter 0 (1) failed: a closure was called with 1 argument (int), which its parameters do not take; write it with 1 parameter, such as |p| ...",
+        ],
+        1,
+    );
+    assert!(!t.contains("anon$"), "{t}");
+}

@@ -166,7 +166,7 @@ fn integer_hint(call: &str, args: &[String], forms: &[String]) -> String {
 }
 
 /// "run_period (Scene, i64)" → a message with the closest name, or the accepted forms.
-fn function_not_found(sig: &str) -> String {
+pub(super) fn function_not_found(sig: &str) -> String {
     let (name, args) = match sig.split_once(" (") {
         Some((n, a)) => (n.trim(), a.trim_end_matches(')')),
         None => (sig.trim(), ""),
@@ -177,6 +177,23 @@ fn function_not_found(sig: &str) -> String {
         args.split(", ").map(shown_type).collect()
     };
     let call = format!("{name}({})", args.join(", "));
+    if name.starts_with("anon$") {
+        // A closure (its function's generated name says nothing) called with a number of
+        // arguments other than its parameters'.
+        let n = args.len();
+        let params = match n {
+            1 => "p".to_string(),
+            _ => (1..=n)
+                .map(|k| format!("p{k}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        };
+        let s = if n == 1 { "" } else { "s" };
+        return format!(
+            "a closure was called with {n} argument{s} ({}), which its parameters do not take; write it with {n} parameter{s}, such as |{params}| ...",
+            args.join(", ")
+        );
+    }
     if is_operator(name) {
         return operator_not_found(name, &args);
     }

@@ -8,6 +8,9 @@ pub fn show(v: &Dynamic) -> String {
     if let Some(text) = super::types::swimlab_text(v) {
         return text;
     }
+    if let Some(f) = v.read_lock::<rhai::FnPtr>() {
+        return super::types::fn_text(&f);
+    }
     if let Some(a) = v.clone().try_cast::<Array>() {
         return format!("[{}]", a.iter().map(show).collect::<Vec<_>>().join(", "));
     }

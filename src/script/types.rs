@@ -17,8 +17,12 @@ const QUOTED_CHARS: usize = 80;
 
 macro_rules! script_types {
     ($($t:ty => $name:literal),+ $(,)?) => {
-        /// Register every script type with its name and its `Display` as `to_string`/`to_debug`.
+        /// Register every script type with its name and its `Display` as `to_string`/`to_debug`,
+        /// and a closure's text without its generated name.
         pub fn register(engine: &mut Engine) {
+            engine
+                .register_fn("to_string", |f: &mut rhai::FnPtr| fn_text(f))
+                .register_fn("to_debug", |f: &mut rhai::FnPtr| fn_text(f));
             $(
                 engine
                     .register_type_with_name::<$t>($name)
@@ -55,6 +59,16 @@ script_types! {
     RecorderHandle => "Recorder",
     Field => "Field",
     Picture => "Picture",
+}
+
+/// A function pointer's text: `Fn(name)`, or `Fn(a closure)` for a closure, whose function has a
+/// generated name ("anon$5f3c...") that says nothing.
+pub fn fn_text(f: &rhai::FnPtr) -> String {
+    if f.fn_name().starts_with("anon$") {
+        "Fn(a closure)".into()
+    } else {
+        format!("Fn({})", f.fn_name())
+    }
 }
 
 /// Rhai's names of its own types (as `Dynamic::type_name` and its messages give them) in the
