@@ -462,3 +462,27 @@ fn closures_are_named_as_such() {
     );
     assert!(!t.contains("anon$"), "{t}");
 }
+
+/// A swimlab function called with arguments none of its forms takes raises, caught or not, the
+/// message that lists its forms: a `catch` receives that text, not Rhai's error map with Rust's
+/// spelling of the argument types ("&str | ImmutableString | String"). A form that exists and
+/// fails keeps its own error, and a script's own function of the same name is still called.
+#[test]
+fn a_caught_wrong_call_reads_as_an_uncaught_one() {
+    let forms = "add_at cannot be called as add_at(Scene, Dumbbell, string); its forms: add_at(Scene, Dumbbell, array)";
+    let t = case(
+        &format!("{PAIR}let d = dumbbell();\ntry {{ s.add_at(d, \"x\"); }} catch (e) {{ print(type_of(e)); print(e); }}\ntry {{ s.diffusion(\"x\", 1, 2); }} catch (e) {{ print(e); }}\ntry {{ s.run_periods(-1); }} catch (e) {{ print(e); }}\nfn field(x) {{ x * 2 }}\nprint(field(21));\ns.add_at(d, \"x\");"),
+        &[
+            &format!("string\n{forms}\n"),
+            "diffusion cannot be called as diffusion(Scene, string, int, int); its forms: diffusion(Scene, int)",
+            "the number of periods must be >= 0, got -1",
+            "\n42\n",
+            &format!(":10:3: {forms}"),
+        ],
+        1,
+    );
+    assert!(
+        !t.contains("ImmutableString") && !t.contains("ErrorFunctionNotFound"),
+        "{t}"
+    );
+}
