@@ -446,6 +446,120 @@ fn row_limits_name_the_trajectory_and_csv_keeps_to_csv_names() {
     }
 }
 
+/// `Scene::add_many` (what `add_at` calls) makes the checks of one `add` after another, with the
+/// same first failure and, when all fit, the same scene; a failure leaves the scene unchanged.
+#[test]
+fn adding_many_checks_as_one_add_after_another() {
+    use swimlab::engine::swimmer::Dumbbell;
+    use swimlab::engine::{Model, Scene};
+    /// SplitMix64 in [0, 1).
+    struct Rng(u64);
+    impl Rng {
+        fn uniform(&mut self) -> f64 {
+            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+    type Outcome = Result<(), (usize, String)>;
+    let mut rng = Rng(38);
+    let (mut refused, mut overlapping) = (0, 0);
+    for case in 0..120 {
+        let mut scene = Scene::new();
+        if case % 3 == 1 {
+            scene.set_model(Model::Averaged);
+        }
+        let side = 20e-6 + 180e-6 * rng.uniform();
+        if case % 2 == 0 {
+            scene
+                .set_box(Some([side, side * (0.5 + rng.uniform()), side]))
+                .unwrap();
+        }
+        let small = Dumbbell {
+            a2: 0.4e-6,
+            ..Dumbbell::default()
+        };
+        let point = |rng: &mut Rng| {
+            nalgebra::Vector3::new(
+                side * (2.0 * rng.uniform() - 1.0),
+                side * (2.0 * rng.uniform() - 1.0),
+                side * (2.0 * rng.uniform() - 1.0),
+            )
+        };
+        // A few swimmers there already.
+        for _ in 0..3 {
+            let _ = scene.add(Dumbbell::default(), point(&mut rng), point(&mut rng));
+        }
+        let items: Vec<_> = (0..200)
+            .map(|k| {
+                let d = if k % 5 == 0 {
+                    small
+                } else {
+                    Dumbbell::default()
+                };
+                let mut c = point(&mut rng);
+                let mut dir = point(&mut rng);
+                match (rng.uniform() * 400.0) as u32 {
+                    0 => c.x = f64::NAN,
+                    1 => dir = nalgebra::Vector3::zeros(),
+                    2 => c.y = 1e20,
+                    _ => {}
+                }
+                (d, c, dir)
+            })
+            .collect();
+        let mut one_by_one = scene.clone();
+        let mut expected: Outcome = Ok(());
+        for (k, (d, c, dir)) in items.iter().enumerate() {
+            if let Err(e) = one_by_one.add(*d, *c, *dir) {
+                expected = Err((k, e.to_string()));
+                break;
+            }
+        }
+        let mut at_once = scene.clone();
+        let got: Outcome = at_once
+            .add_many(&items)
+            .map_err(|(k, e)| (k, e.to_string()));
+        assert_eq!(got, expected, "case {case}");
+        match got {
+            Ok(()) => {
+                assert_eq!(at_once.count(), one_by_one.count());
+                for i in 0..at_once.count() {
+                    assert_eq!(at_once.spheres(i), one_by_one.spheres(i), "case {case}");
+                }
+            }
+            Err((_, msg)) => {
+                refused += 1;
+                overlapping += usize::from(msg.contains("would overlap"));
+                assert_eq!(at_once.count(), scene.count(), "unchanged: case {case}");
+            }
+        }
+    }
+    // Both outcomes, and both kinds of refusal, were met.
+    assert!(
+        refused < 120 && overlapping > 0 && overlapping < refused,
+        "{refused} refused, {overlapping} for overlaps"
+    );
+}
+
+/// In a script, `add_at` names the centre that one `add` after another would have stopped at
+/// (an overlap before an unreadable centre is named first), and leaves the scene unchanged.
+#[test]
+fn add_at_names_the_first_failure_and_adds_none() {
+    case(
+        "let s = scene();\ns.add(dumbbell(#{ center: [0, 50e-6, 0] }));\ntry { s.add_at(dumbbell(), [[0, 0, 0], [1e-6, 0, 0], \"x\"]); } catch (e) { print(e); }\ntry { s.add_at(dumbbell(), [[0, 0, 0], \"x\", [1e-6, 0, 0]]); } catch (e) { print(e); }\ntry { s.add_at(dumbbell(), [[0, 0, 0], [30e-6, 0, 0], [0, 50e-6, 1e-6]]); } catch (e) { print(e); }\nprint(s.count);\nprint(s.add_at(dumbbell(), [[0, 0, 0], [30e-6, 0, 0]]));",
+        &[
+            "add_at: centre 1: the new swimmer would overlap swimmer 1 (sphere gap",
+            "add_at: centre 1 must be an array of 3 numbers such as [1.0, 0.0, 0.0], got \"x\" (string)",
+            "add_at: centre 2: the new swimmer would overlap swimmer 0 (sphere gap",
+            "place its centre further away\n1\n3\n",
+        ],
+        0,
+    );
+}
+
 /// A closure is shown as one, never by the generated name of its function ("anon$5f3c..."):
 /// printed, displayed, in a string, in an array or a map, quoted by a message, and when it is
 /// called with a number of arguments its parameters do not take.

@@ -89,9 +89,14 @@ fn check_center<'a>(
     center: &Vector3<f64>,
     ds: impl IntoIterator<Item = &'a Dumbbell>,
 ) -> Result<()> {
-    let Some((limit, r)) = extent_limit(ds) else {
-        return Ok(());
-    };
+    match extent_limit(ds) {
+        Some(reach) => check_center_within(center, reach),
+        None => Ok(()),
+    }
+}
+
+/// [`check_center`] with the reach and the smallest radius, `(limit, r)`, already known.
+fn check_center_within(center: &Vector3<f64>, (limit, r): (f64, f64)) -> Result<()> {
     for (k, c) in ["x", "y", "z"].iter().zip(center.iter()) {
         if c.abs() > limit {
             return Err(invalid!(
@@ -108,9 +113,14 @@ fn check_center<'a>(
 
 /// Refuse a box whose sides the scene's positions cannot carry ([`MAX_EXTENT_IN_RADII`]).
 fn check_box_extent<'a>(b: &PeriodicBox, ds: impl IntoIterator<Item = &'a Dumbbell>) -> Result<()> {
-    let Some((limit, r)) = extent_limit(ds) else {
-        return Ok(());
-    };
+    match extent_limit(ds) {
+        Some(reach) => check_box_within(b, reach),
+        None => Ok(()),
+    }
+}
+
+/// [`check_box_extent`] with the reach and the smallest radius, `(limit, r)`, already known.
+fn check_box_within(b: &PeriodicBox, (limit, r): (f64, f64)) -> Result<()> {
     for (k, l) in ["x", "y", "z"].iter().zip(b.sides()) {
         if l > limit {
             return Err(invalid!(
@@ -128,6 +138,13 @@ fn check_box_extent<'a>(b: &PeriodicBox, ds: impl IntoIterator<Item = &'a Dumbbe
 /// `margin`; a NaN gap is not.
 fn clear(gap: f64, margin: f64) -> bool {
     gap > margin
+}
+
+/// A new swimmer's spheres meet those of swimmer `s` (the gap, m, is ≤ 0 or NaN).
+fn overlap_error(s: usize, gap: f64) -> EngineError {
+    invalid!(
+        "the new swimmer would overlap swimmer {s} (sphere gap {gap:.3e} m); place its centre further away"
+    )
 }
 
 fn check_fits_box(d: &Dumbbell, b: &PeriodicBox) -> Result<()> {
@@ -256,6 +273,71 @@ impl Scene {
         d.validate()?;
         self.check_room(&d, center, dir, 0.0)?;
         let n = unit_direction(dir)?;
+        self.push_unchecked(d, center, n);
+        Ok(self.swimmers.len() - 1)
+    }
+
+    /// Add swimmers `(d, center, dir)` in order, all or none: the same checks as [`Scene::add`]
+    /// one after another would make, each swimmer against the scene's and the earlier new ones,
+    /// with the same first failure (the index into `items` and its error); on a failure the
+    /// scene is unchanged. The overlaps are found through cell lists, O(n) for n swimmers at a
+    /// bounded density, where adding them one at a time measures every pair, O(n²).
+    pub fn add_many(
+        &mut self,
+        items: &[(Dumbbell, Vector3<f64>, Vector3<f64>)],
+    ) -> std::result::Result<(), (usize, EngineError)> {
+        // Everything but the overlaps, in order; the overlaps are looked for before the first
+        // swimmer that fails here.
+        let mut failed: Option<(usize, EngineError)> = None;
+        let mut dirs = Vec::with_capacity(items.len());
+        let mut a_min = self
+            .swimmers
+            .iter()
+            .map(|o| o.a1.min(o.a2))
+            .fold(f64::INFINITY, f64::min);
+        for (k, (d, center, dir)) in items.iter().enumerate() {
+            let checked = d.validate().and_then(|()| {
+                for (name, c) in ["x", "y", "z"].iter().zip(center.iter()) {
+                    require_finite(&format!("center.{name}"), *c)?;
+                }
+                let n = unit_direction(*dir)?;
+                // The reach of the scene with this swimmer and the ones before it.
+                a_min = a_min.min(d.a1.min(d.a2));
+                let reach = (MAX_EXTENT_IN_RADII * a_min, a_min);
+                check_center_within(center, reach)?;
+                if let Some(b) = &self.periodic {
+                    check_fits_box(d, b)?;
+                    check_box_within(b, reach)?;
+                }
+                Ok(n)
+            });
+            match checked {
+                Ok(n) => dirs.push(n),
+                Err(e) => {
+                    failed = Some((k, e));
+                    break;
+                }
+            }
+        }
+        // Placed, then measured where the scene holds them (as one add after another would).
+        let old = self.count();
+        for ((d, center, _), n) in items.iter().zip(&dirs) {
+            self.push_unchecked(*d, *center, *n);
+        }
+        if let Some((k, s, gap)) = self.first_overlap(old, &dirs) {
+            self.truncate(old);
+            return Err((k, overlap_error(s, gap)));
+        }
+        if let Some(f) = failed {
+            self.truncate(old);
+            return Err(f);
+        }
+        Ok(())
+    }
+
+    /// Add swimmer `d` (valid, its room checked by the caller) with hydrodynamic centre `center`
+    /// and unit orientation `n`.
+    fn push_unchecked(&mut self, d: Dumbbell, center: Vector3<f64>, n: Vector3<f64>) {
         let len = d.rest_length(self.time);
         self.swimmers.push(d);
         self.base.push(center);
@@ -265,7 +347,87 @@ impl Scene {
         };
         self.state
             .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
-        Ok(self.swimmers.len() - 1)
+    }
+
+    /// Keep the first `count` swimmers only.
+    fn truncate(&mut self, count: usize) {
+        self.swimmers.truncate(count);
+        self.base.truncate(count);
+        self.state.truncate(STATE_PER_SWIMMER * count);
+    }
+
+    /// For [`Scene::add_many`], with its swimmers from `old` on just placed along `dirs`: the
+    /// first of them (counted from `old`) that [`Scene::add`] would have refused for an overlap
+    /// (a gap ≤ 0 between one of its spheres, where `add` measures them, and a sphere of an
+    /// earlier swimmer, where the scene holds it), the first swimmer it overlaps, and the gap
+    /// `add` would name.
+    fn first_overlap(&self, old: usize, dirs: &[Vector3<f64>]) -> Option<(usize, usize, f64)> {
+        let total = self.count();
+        let (mut x, mut y, mut z) = (
+            vec![0.0; 2 * total],
+            vec![0.0; 2 * total],
+            vec![0.0; 2 * total],
+        );
+        let mut radii = Vec::with_capacity(2 * total);
+        for i in 0..total {
+            let (x1, x2) = self.spheres(i);
+            for (k, p) in [x1, x2].into_iter().enumerate() {
+                (x[2 * i + k], y[2 * i + k], z[2 * i + k]) = (p.x, p.y, p.z);
+            }
+            radii.extend([self.swimmers[i].a1, self.swimmers[i].a2]);
+        }
+        let at = |j: usize| Vector3::new(x[j], y[j], z[j]);
+        let a_max = radii.iter().copied().fold(0.0, f64::max);
+        // Spheres overlap closer than the sum of their radii, at most 2 a_max: every such pair
+        // is in neighbouring cells of that side.
+        let side = 2.0 * a_max;
+        let wraps = self.periodic.is_none_or(|b| side <= 0.5 * b.shortest());
+        let grid = (side > 0.0 && side.is_finite() && wraps)
+            .then(|| super::cells::CellGrid::build_in(&x, &y, &z, side, self.periodic.as_ref()));
+        let gap = |p: Vector3<f64>, a: f64, j: usize| {
+            separation(self.periodic.as_ref(), p - at(j)).norm() - a - radii[j]
+        };
+        let mut runs = Vec::with_capacity(27);
+        for (k, n) in dirs.iter().enumerate() {
+            let swimmer = old + k;
+            let d = &self.swimmers[swimmer];
+            let (c1, c2) = d.sphere_positions(self.base[swimmer], *n, self.contact_length(d));
+            let mine = [(c1, d.a1), (c2, d.a2)];
+            let mut first: Option<usize> = None;
+            for &(p, a) in &mine {
+                let mut check = |j: usize| {
+                    if !clear(gap(p, a, j), 0.0) && first.is_none_or(|s| j / 2 < s) {
+                        first = Some(j / 2);
+                    }
+                };
+                match &grid {
+                    Some(g) => {
+                        g.neighbour_runs(p.x, p.y, p.z, &mut runs);
+                        for &(from, to) in &runs {
+                            // A run holds its points in ascending order: the earlier swimmers'
+                            // spheres come first.
+                            for &j in &g.order[from as usize..to as usize] {
+                                if j as usize >= 2 * swimmer {
+                                    break;
+                                }
+                                check(j as usize);
+                            }
+                        }
+                    }
+                    None => (0..2 * swimmer).for_each(check),
+                }
+            }
+            if let Some(s) = first {
+                // The gap `add` names: the first overlapping pair in its order.
+                let named = mine
+                    .iter()
+                    .flat_map(|&(p, a)| [2 * s, 2 * s + 1].map(|j| gap(p, a, j)))
+                    .find(|&g| !clear(g, 0.0))
+                    .unwrap_or(f64::NAN);
+                return Some((k, s, named));
+            }
+        }
+        None
     }
 
     /// Whether [`Scene::add`] would accept this swimmer with every sphere gap above `margin` (m):
@@ -306,9 +468,7 @@ impl Scene {
                 for (yb, ab) in [(y1, other.a1), (y2, other.a2)] {
                     let gap = separation(self.periodic.as_ref(), xa - yb).norm() - aa - ab;
                     if !clear(gap, margin) {
-                        return Err(invalid!(
-                            "the new swimmer would overlap swimmer {s} (sphere gap {gap:.3e} m); place its centre further away"
-                        ));
+                        return Err(overlap_error(s, gap));
                     }
                 }
             }

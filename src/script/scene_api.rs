@@ -255,15 +255,28 @@ fn add_random(
 /// `s.add_at(d, centres)`: a copy of d (its orientation and phase) at every centre of the array,
 /// in order; all or nothing (the scene is unchanged if one does not fit).
 fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult<INT> {
-    let mut trial = s.borrow().scene().clone();
+    // The centres up to the first that is not a point; the swimmers before it are checked
+    // first, as adding them one by one would.
+    let mut items = Vec::with_capacity(centres.len());
+    let mut unreadable = None;
     for (k, c) in centres.iter().enumerate() {
-        let c = super::convert::vector3(&format!("add_at: centre {k}"), c)?;
-        trial.add(d.params, c, d.dir).map_err(|e| {
-            script_error(format!(
-                "add_at: centre {k}: {}",
-                super::convert::engine_message(&e)
-            ))
-        })?;
+        match super::convert::vector3(&format!("add_at: centre {k}"), c) {
+            Ok(c) => items.push((d.params, c, d.dir)),
+            Err(e) => {
+                unreadable = Some(e);
+                break;
+            }
+        }
+    }
+    let mut trial = s.borrow().scene().clone();
+    trial.add_many(&items).map_err(|(k, e)| {
+        script_error(format!(
+            "add_at: centre {k}: {}",
+            super::convert::engine_message(&e)
+        ))
+    })?;
+    if let Some(e) = unreadable {
+        return Err(e);
     }
     s.replace(trial)
 }
