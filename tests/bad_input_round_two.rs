@@ -163,6 +163,21 @@ fn stdlib_and_operators_name_wrong_types() {
         1,
     );
     let t = case(
+        "import \"phases\" as phases;\nlet s = scene();\ns.add(dumbbell());\ntry { phases::random(\"x\", 1); } catch (e) { print(e); }\ntry { phases::random(2, 0.5); } catch (e) { print(e); }\ntry { phases::alternating(2.0, 1); } catch (e) { print(e); }\ntry { phases::alternating(2, \"x\"); } catch (e) { print(e); }\ntry { phases::wave(s, [0, 0, 0], 1e-4); } catch (e) { print(e); }\ntry { phases::wave(s, [1, 0], 1e-4); } catch (e) { print(e); }\ntry { phases::wave(s, [1, 0, 0], 0.0 / 0.0); } catch (e) { print(e); }\nprint(phases::alternating(3, 1));",
+        &[
+            "phases::random: n must be a whole number of swimmers >= 0, such as s.count; got \"x\" (a string)",
+            "phases::random: seed must be a whole number, such as 42; got 0.5 (a float)",
+            "phases::alternating: n must be a whole number of swimmers >= 0, such as s.count; got 2.0 (a float)",
+            "phases::alternating: dphi must be a finite number, such as pi() / 2.0; got \"x\" (a string)",
+            "phases::wave: axis must not be [0, 0, 0]",
+            "phases::wave: axis must be a direction [x, y, z], such as [1, 0, 0]; got [1, 0] (array)",
+            "phases::wave: wavelength must be a finite number, such as 100e-6; got NaN (a float)",
+            "[0.0, 1.0, 2.0]",
+        ],
+        0,
+    );
+    assert!(!t.contains("uniform_randoms"), "{t}");
+    let t = case(
         "let x = 1.0 / \"2\";",
         &["the operator / cannot be applied to float and string"],
         1,
@@ -444,6 +459,40 @@ fn row_limits_name_the_trajectory_and_csv_keeps_to_csv_names() {
     for f in ["r.csv", "r.txt", "w.dat"] {
         assert!(d.join(f).is_file(), "{f}");
     }
+}
+
+/// A lattice is added in time that follows its size: `add_at` finds overlaps through cell lists
+/// and the stdlib sets its points by index (measuring every pair, or walking the whole array for
+/// the size check at every `push`, is O(n²)); an array past the limits is refused before it is
+/// built.
+#[test]
+fn a_large_lattice_is_added_in_time_that_follows_its_size() {
+    // 100,000 swimmers take about a second in an optimised build, where the O(n²) ways take
+    // minutes; the bound leaves room for debug assertions and a loaded machine.
+    let started = Instant::now();
+    case(
+        "import \"lattice\" as lattice;\nlet s = scene();\nprint(s.add_at(dumbbell(), lattice::cubic(50, 50, 40, 20e-6)));\nimport \"phases\" as phases;\ns.phases = phases::alternating(s.count, 0.5);\nprint(s.phases.len());",
+        &["100000\n100000"],
+        0,
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(30),
+        "{:?}",
+        started.elapsed()
+    );
+    case(
+        "import \"lattice\" as lattice;\nlattice::cubic(200, 200, 200, 20e-6);",
+        &[
+            "limit of 20000000 elements in one array",
+            "SWIMLAB_MAX_ARRAY",
+        ],
+        1,
+    );
+    case(
+        "import \"lattice\" as lattice;\nlattice::hexagonal(2000000000, 2000000000, 1e-6);",
+        &["lattice: 2000000000 x 2000000000 = 4e18 points, more than any array holds"],
+        1,
+    );
 }
 
 /// `Scene::add_many` (what `add_at` calls) makes the checks of one `add` after another, with the
