@@ -159,12 +159,14 @@ enum BenchKind {
 }
 
 fn main() -> ExitCode {
+    // Before any thread starts: it may set an environment variable.
+    swimlab::script::quiet_device_selection();
     let cli = Cli::parse();
     let result = if let Some(expr) = cli.eval {
         swimlab::script::interrupt::install_batch_handler();
         swimlab::script::eval_expression(&expr).map(|shown| {
             if let Some(v) = shown {
-                println!("{v}");
+                swimlab::script::console::to_stdout(&format!("{v}\n"));
             }
         })
     } else {

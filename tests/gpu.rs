@@ -497,3 +497,30 @@ fn bench_scaling_has_gpu_series() {
         "{table}"
     );
 }
+
+/// Issue 38: on a machine without a session runtime folder (a server, CI), choosing the GPU
+/// prints nothing but what swimlab says: Mesa's device-selection layer, which would connect to
+/// the Wayland display and have its library print "XDG_RUNTIME_DIR is invalid or not set" twice,
+/// is kept out of the process (the binary, which is what users run).
+#[test]
+fn no_display_noise_without_a_runtime_folder() {
+    if !gpu_present("no_display_noise_without_a_runtime_folder") {
+        return;
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args([
+            "-e",
+            "let s = scene(); s.add(dumbbell()); s.backend = \"gpu\"; s.run_periods(0.01); s.backend_info",
+        ])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("MESA_VK_DEVICE_SELECT")
+        .env("SWIMLAB_PROGRESS", "0")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{stderr}");
+    assert!(stdout.contains("gpu:"), "{stdout}");
+    assert!(stderr.is_empty(), "nothing on stderr: {stderr}");
+}

@@ -125,3 +125,53 @@ fn imports_stay_for_later_inputs() {
     assert_eq!(out(&mut s, "sc.count"), "=> 2");
     assert_eq!(out(&mut s, "paper::ell()"), "=> 5e-6");
 }
+
+/// A variable hidden by a later `let` of the same name is dropped: a notebook cell run again
+/// makes its scene and its trajectory afresh, and the hidden scene's recorder lets its file go
+/// (two writers on one file are refused while both live).
+#[test]
+fn a_cell_run_again_writes_its_trajectory_afresh() {
+    let dir = std::env::temp_dir().join(format!("swimlab-repl-rerun-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("t.xyz");
+    let cell = format!(
+        "let s = scene(); s.add(dumbbell()); s.trajectory(\"{}\", 0.5); s.run_periods(1);",
+        path.display()
+    );
+    let mut s = Session::new();
+    out(&mut s, &cell);
+    out(&mut s, &cell);
+    let vars = out(&mut s, ":vars");
+    assert_eq!(vars.matches("let s:").count(), 1, "{vars}");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(
+        text.matches("Properties=").count(),
+        3,
+        "three frames: {text}"
+    );
+    match s.handle(&format!(
+        "let t = s; s.trajectory(\"{}\", 1);",
+        path.display()
+    )) {
+        Reply::Error(e) => assert!(e.contains("is being written by a trajectory"), "{e}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// An input that fails before it declares a variable anew leaves the old one as it was (it was
+/// only set aside for the run); one that reads the variable in its own declaration keeps it too.
+#[test]
+fn a_failed_redeclaration_keeps_the_old_variable() {
+    let mut s = Session::new();
+    out(&mut s, "let sc = scene(); sc.add(dumbbell());");
+    assert!(matches!(
+        s.handle("let sc = load_scene(\"no/such/scene.json\");"),
+        Reply::Error(_)
+    ));
+    assert_eq!(out(&mut s, "sc.count"), "=> 1");
+    out(
+        &mut s,
+        "let sc = sc.copy(); sc.add(dumbbell(#{ center: [20e-6, 0, 0] }));",
+    );
+    assert_eq!(out(&mut s, "sc.count"), "=> 2");
+}

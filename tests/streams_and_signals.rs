@@ -2,7 +2,8 @@
 //! taken, so `kill -9` loses no row already recorded and leaves no half line; SIGINT stops
 //! `swimlab run` at a step boundary as Ctrl-C does in the shell (the script gets the interrupt
 //! error, the stream is complete, the exit code is 130); the shell appends each command to its
-//! history as it is entered, so a killed terminal keeps it.
+//! history as it is entered, so a killed terminal keeps it; a closed standard output ends a run
+//! quietly, as SIGPIPE ends other command-line tools.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -142,4 +143,80 @@ fn sigint_stops_swimlab_run_at_a_step_boundary_and_keeps_the_rows() {
         rows + 1 >= seen,
         "{rows} rows, {seen} lines seen before SIGINT"
     );
+}
+
+/// A reader that closes standard output early (`swimlab run s.rhai | head -1`) ends the run
+/// quietly with the status a shell gives a process that SIGPIPE ended (141), and rows already
+/// streamed stay whole (Rhai's own `print` would panic there: "failed printing to stdout: Broken
+/// pipe", an internal error).
+#[test]
+fn a_closed_standard_output_ends_the_run_quietly() {
+    use std::io::BufRead;
+    let d = dir("closed-stdout");
+    let script = d.join("many.rhai");
+    let csv = d.join("rows.csv");
+    std::fs::write(
+        &script,
+        format!(
+            "let s = scene();\ns.add(dumbbell());\nlet r = s.record([R_H(0)], every_periods(0.1));\nr.stream_csv(\"{}\");\ns.run_periods(1);\nfor i in 0..100000000 {{ print(i); }}\n",
+            csv.display()
+        ),
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", script.to_str().unwrap()])
+        .env("SWIMLAB_PROGRESS", "0")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start swimlab");
+    let mut first = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert_eq!(first, "0\n");
+    // The reader is dropped here: the pipe is closed.
+    let status = wait_within(&mut child, Duration::from_secs(60));
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(status.code(), Some(141), "stderr:\n{err}");
+    assert!(err.is_empty(), "quietly: {err}");
+    assert_eq!(
+        whole_rows(&csv),
+        10,
+        "the rows of the one-period run, whole"
+    );
+}
+
+/// The same for piped input (`swimlab < session.rhai | head -1`): the values the shell shows
+/// meet the closed output, and the session ends quietly with 141 instead of running on unread.
+#[test]
+fn a_closed_standard_output_ends_a_piped_session_quietly() {
+    use std::io::BufRead;
+    let d = dir("closed-stdout-piped");
+    let input = d.join("session.rhai");
+    // Far more values than a pipe's buffer holds, each shown on its own line.
+    std::fs::write(
+        &input,
+        "let i = 0;\n".to_string() + &"i += 1; i\n".repeat(200_000),
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .env("SWIMLAB_PROGRESS", "0")
+        .stdin(std::fs::File::open(&input).unwrap())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start swimlab");
+    let mut first = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert_eq!(first, "=> 1\n");
+    let status = wait_within(&mut child, Duration::from_secs(60));
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(status.code(), Some(141), "stderr:\n{err}");
+    assert!(err.is_empty(), "quietly: {err}");
 }

@@ -1,6 +1,7 @@
 //! Trajectories for particle viewers: extended XYZ read back by ASE (a real outside reader, in
 //! the Python environment `.ci/run` makes), the ParaView series read back by vtkio's parser, both
-//! sharing the recorders' triggers, and an XYZ stream that keeps every frame through `kill -9`.
+//! sharing the recorders' triggers, an XYZ stream and a ParaView series that keep every frame
+//! through `kill -9`, and one writer per file.
 
 mod common;
 use common::python_with;
@@ -304,4 +305,146 @@ fn ase_reads_a_periodic_box() {
             );
         }
     }
+}
+
+/// The `.pvd` is appended in place, frame by frame (the same file from the first frame to the
+/// last, never rewritten whole: each frame costs the same however many came before), and lists
+/// every frame with its time.
+#[test]
+fn the_paraview_collection_is_appended_in_place() {
+    use std::os::unix::fs::MetadataExt;
+    let d = dir("pvd-append");
+    let path = d.join("pair.pvd");
+    let mut sim = Simulation::new(common::mirror_inwards(10.0, true));
+    sim.trajectory(&path, Trigger::EveryPeriods(0.01)).unwrap();
+    let inode = std::fs::metadata(&path).unwrap().ino();
+    sim.run_periods(0.5).unwrap();
+    assert_eq!(
+        std::fs::metadata(&path).unwrap().ino(),
+        inode,
+        "rewritten whole"
+    );
+    let pvd = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(pvd.matches("<DataSet ").count(), 51, "{pvd}");
+    assert!(pvd.ends_with("  </Collection>\n</VTKFile>\n"), "{pvd}");
+    let listed: Vec<&str> = pvd
+        .lines()
+        .filter_map(|l| l.split("file=\"").nth(1))
+        .map(|rest| rest.split('"').next().unwrap())
+        .collect();
+    for f in &listed {
+        assert!(d.join(f).is_file(), "{f}");
+    }
+    let names: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().all(|n| !n.contains("tmp")), "{names:?}");
+}
+
+/// `kill -9` during a run with a ParaView series leaves a `.pvd` that ends in its closing lines and
+/// lists only whole frames, and no temporary file but, at most, the one of the frame being
+/// written, inside the frames folder.
+#[test]
+fn kill_9_leaves_a_whole_paraview_series() {
+    let d = dir("kill9-pvd");
+    let pvd = d.join("long.pvd");
+    let script = d.join("long.rhai");
+    std::fs::write(
+        &script,
+        format!(
+            "import \"paper\" as paper;\nlet s = paper::mirror(10.0, true, true);\ns.trajectory(\"{}\", every_periods(0.01));\ns.run_periods(10000);\n",
+            pvd.display()
+        ),
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", script.to_str().unwrap()])
+        .env("SWIMLAB_PROGRESS", "0")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while std::fs::read_to_string(&pvd)
+        .unwrap_or_default()
+        .matches("<DataSet ")
+        .count()
+        < 20
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no frames written"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(Command::new("kill")
+        .args(["-9", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let _ = child.wait();
+    let text = std::fs::read_to_string(&pvd).unwrap();
+    assert!(text.ends_with("  </Collection>\n</VTKFile>\n"), "{text}");
+    for f in text
+        .lines()
+        .filter_map(|l| l.split("file=\"").nth(1))
+        .map(|rest| rest.split('"').next().unwrap())
+    {
+        vtkio::Vtk::import(d.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+    }
+    let outside: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("tmp"))
+        .collect();
+    assert!(outside.is_empty(), "{outside:?}");
+    let inside = std::fs::read_dir(d.join("long_frames"))
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".tmp")
+        })
+        .count();
+    assert!(inside <= 1, "{inside} temporary files");
+}
+
+/// One writer per file: a second trajectory, or a whole-file write, on a path a trajectory of
+/// this process is writing is refused, and the first keeps whole frames. CSV cannot reach it: a
+/// CSV stream or file under a trajectory's name is refused for the name first.
+#[test]
+fn a_second_writer_on_a_trajectory_is_refused() {
+    let d = dir("claim");
+    let path = d.join("t.xyz");
+    let mut sim = Simulation::new(common::mirror_inwards(10.0, true));
+    sim.trajectory(&path, Trigger::EveryPeriods(0.5)).unwrap();
+    let mut other = Simulation::new(common::mirror_inwards(10.0, true));
+    // Another spelling of the same file.
+    let same = d.join(".").join("t.xyz");
+    let e = other
+        .trajectory(&same, Trigger::EveryPeriods(0.5))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("is being written by a trajectory"), "{e}");
+    let id = other
+        .record(Vec::new(), Trigger::EveryPeriods(1.0))
+        .unwrap();
+    let e = other.stream_csv(id, &path).unwrap_err();
+    assert!(e.to_string().contains("ends in .xyz"), "{e}");
+    let e = other.recorder(id).unwrap().write_csv(&path).unwrap_err();
+    assert!(e.to_string().contains("ends in .xyz"), "{e}");
+    let e = swimlab::engine::files::write_atomically(&same, |w| w.write_all(b"x\n")).unwrap_err();
+    assert!(
+        e.to_string().contains("is being written by a trajectory"),
+        "{e}"
+    );
+    sim.run_periods(1.0).unwrap();
+    let (frames, whole) = whole_frames(&std::fs::read_to_string(&path).unwrap());
+    assert_eq!((frames, whole), (3, true));
+    drop(sim);
+    other.trajectory(&path, Trigger::EveryPeriods(0.5)).unwrap();
 }

@@ -6,7 +6,7 @@ use super::error::{invalid, EngineError, Result};
 use super::integrators::{require_resolvable, IntegratorSpec};
 use super::model::{vec3, Model, STATE_PER_SWIMMER};
 use super::plan::plan;
-use super::scene::Scene;
+use super::scene::{Scene, MAX_TIME_IN_PERIODS};
 use super::stepping::{advance_cpu, advance_gpu, RunControl, Workspace};
 use nalgebra::Vector3;
 
@@ -31,11 +31,29 @@ pub fn advance_to(
     }
 }
 
-/// What the integrator refuses before a run of `s` to `t_end` starts: a fixed step that cannot
-/// advance the time, or more than [`MAX_FIXED_STEPS_PER_RUN`] steps.
+/// What is refused before a run of `s` to `t_end` starts, whatever the integrator: an end past
+/// the latest time a scene may hold ([`Scene::latest_time`], which a saved scene could not be
+/// loaded at); and of a fixed-step integrator, a step that cannot advance the time, or more than
+/// [`MAX_FIXED_STEPS_PER_RUN`] steps.
 pub fn check_steps(s: &Scene, t_end: f64) -> Result<()> {
     if t_end <= s.time() {
         return Ok(());
+    }
+    let latest = s.latest_time();
+    // A NaN end is not within the latest time: refused as well.
+    let within = t_end <= latest;
+    if !within {
+        let periods = |t: f64| {
+            s.period()
+                .map_or(String::new(), |p| format!(" ({:.6e} periods)", t / p))
+        };
+        return Err(invalid!(
+            "this run would end at t = {t_end:.6e} s{}, past the latest time a scene may hold, {latest:.6e} s{} ({MAX_TIME_IN_PERIODS:e} stroke periods: beyond, f64 no longer resolves the stroke, and a saved scene would not load); run at most {:.6e} s{} more, or continue in a new scene from time 0",
+            periods(t_end),
+            periods(latest),
+            latest - s.time(),
+            periods(latest - s.time()),
+        ));
     }
     if let IntegratorSpec::Euler { dt }
     | IntegratorSpec::Rk4 { dt }

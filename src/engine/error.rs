@@ -33,6 +33,10 @@ pub enum Setting {
     NoNoise,
     /// A scheme for thermal noise: Euler-Maruyama or Platen's weak second-order scheme.
     NoiseIntegrator,
+    /// Sum the box's mobility products by this Ewald method ("auto", "beenakker", "spectral").
+    EwaldMethod(&'static str),
+    /// A looser tolerance of the box's Ewald sums.
+    LooserEwaldTol,
 }
 
 impl std::fmt::Display for Setting {
@@ -58,6 +62,8 @@ impl std::fmt::Display for Setting {
             Setting::NoiseIntegrator => f.write_str(
                 "a scheme for thermal noise: euler (Euler-Maruyama) or platen (weak order 2) with a step dt",
             ),
+            Setting::EwaldMethod(m) => write!(f, "the {m} Ewald method"),
+            Setting::LooserEwaldTol => f.write_str("a looser tolerance of the Ewald sums (e.g. 1e-6)"),
         }
     }
 }

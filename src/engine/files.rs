@@ -2,10 +2,125 @@
 //! renamed over it (a crash or kill leaves the old file whole), and row streams append one whole
 //! line per write, flushed at once (a kill loses no row already recorded and never leaves half a
 //! line).
+//!
+//! A file that a writer keeps open (a row stream, a trajectory) is claimed for as long as the
+//! writer lives: no other writer of this process may open it, and no whole-file write may replace
+//! it, so two recorders never interleave their lines in one file. One exception: the writer of
+//! an owner that is being replaced (a scene a shell input declares anew, see
+//! [`super::simulation::Simulation::set_retiring`]) gives its file up to a new writer and writes
+//! no more.
 
 use super::error::{invalid, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// A file claimed by a writer of this process.
+struct Held {
+    key: PathBuf,
+    /// What holds it, in words.
+    holder: String,
+    /// Whether the holder's owner is being replaced (its file may be taken over).
+    retiring: Option<Arc<AtomicBool>>,
+    /// Set when another writer took the file over.
+    taken: Arc<AtomicBool>,
+}
+
+/// Files claimed by the writers of this process.
+static CLAIMED: Mutex<Vec<Held>> = Mutex::new(Vec::new());
+
+/// Where `path` is, the same for every spelling of it: its folder's canonical path and its name
+/// (`None` if the folder does not exist).
+fn claim_key(path: &Path) -> Option<PathBuf> {
+    let name = path.file_name()?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    Some(std::fs::canonicalize(dir).ok()?.join(name))
+}
+
+/// What holds `path`, if a writer of this process claimed it.
+fn holder(path: &Path) -> Option<String> {
+    let key = claim_key(path)?;
+    let claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
+    claimed
+        .iter()
+        .find(|h| h.key == key)
+        .map(|h| h.holder.clone())
+}
+
+fn held_error(path: &Path, holder: &str) -> super::error::EngineError {
+    invalid!(
+        "{} is being written by {holder} in this session; a second writer would mix its lines into that file: give this one another path",
+        path.display()
+    )
+}
+
+/// A file claimed by one writer for as long as this lives (see the module docs).
+#[derive(Debug)]
+pub struct Claim {
+    key: PathBuf,
+    taken: Arc<AtomicBool>,
+}
+
+impl Claim {
+    /// Claim `path` (its folder must exist) for a writer described by `what` ("a trajectory"),
+    /// owned by something that may be replaced while the claim lives (`retiring`), unless
+    /// another writer of this process holds it (and its owner is not being replaced).
+    pub fn take(path: &Path, what: &str, retiring: Option<Arc<AtomicBool>>) -> Result<Claim> {
+        let key = claim_key(path).ok_or_else(|| {
+            invalid!(
+                "cannot write {}: its folder does not exist; give a path such as \"out/run.csv\"",
+                path.display()
+            )
+        })?;
+        let mut claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = claimed.iter().position(|h| h.key == key) {
+            let h = &claimed[i];
+            if !h
+                .retiring
+                .as_ref()
+                .is_some_and(|r| r.load(Ordering::SeqCst))
+            {
+                return Err(held_error(path, &h.holder));
+            }
+            h.taken.store(true, Ordering::SeqCst);
+            claimed.swap_remove(i);
+        }
+        let taken = Arc::new(AtomicBool::new(false));
+        claimed.push(Held {
+            key: key.clone(),
+            holder: what.to_string(),
+            retiring,
+            taken: taken.clone(),
+        });
+        Ok(Claim { key, taken })
+    }
+
+    /// Whether this claim is on `path`.
+    pub fn is_on(&self, path: &Path) -> bool {
+        claim_key(path).is_some_and(|k| k == self.key)
+    }
+
+    /// Whether another writer took the file over (this one must write no more).
+    pub fn lost(&self) -> bool {
+        self.taken.load(Ordering::SeqCst)
+    }
+}
+
+impl Drop for Claim {
+    fn drop(&mut self) {
+        let mut claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = claimed
+            .iter()
+            .position(|h| Arc::ptr_eq(&h.taken, &self.taken))
+        {
+            claimed.swap_remove(i);
+        }
+    }
+}
 
 /// Create the folder that will hold `path`, with an error that names the fix.
 pub fn ensure_parent(path: &Path) -> Result<()> {
@@ -18,6 +133,61 @@ pub fn ensure_parent(path: &Path) -> Result<()> {
         })?;
     }
     Ok(())
+}
+
+/// File name endings of formats other than CSV that swimlab writes or that programs open by their
+/// ending, with what they are.
+const NOT_CSV: &[(&str, &str)] = &[
+    ("png", "a PNG picture"),
+    ("svg", "an SVG picture"),
+    ("gif", "a GIF animation"),
+    ("jpg", "a JPEG picture"),
+    ("jpeg", "a JPEG picture"),
+    ("pdf", "a PDF document"),
+    ("vti", "VTK image data"),
+    ("vtp", "VTK poly data"),
+    ("vtk", "a VTK file"),
+    ("pvd", "a ParaView series"),
+    ("xyz", "an extended XYZ trajectory"),
+    ("json", "JSON (a saved scene)"),
+    ("rhai", "a script"),
+];
+
+/// Refuse writing CSV text to `path` when its name says another format (a `.png` that no picture
+/// viewer would open): `what` is the writer ("to_csv").
+pub fn check_csv_name(path: &Path, what: &str) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if let Some((e, format)) = ext.and_then(|x| NOT_CSV.iter().find(|(e, _)| *e == x)) {
+        return Err(invalid!(
+            "{what}: {} ends in .{e}, the name of {format}, but this writes CSV text that the programs opening .{e} files cannot read; give a name ending in .csv",
+            path.display()
+        ));
+    }
+    Ok(())
+}
+
+/// Create (or truncate) the file `path` for writing, its folder created, with errors that name
+/// the path and the fix.
+pub fn create(path: &Path) -> Result<std::fs::File> {
+    if path.as_os_str().is_empty() {
+        return Err(invalid!(
+            "cannot write a file with an empty name; give a path such as \"out/run.csv\""
+        ));
+    }
+    ensure_parent(path)?;
+    if path.is_dir() {
+        return Err(invalid!(
+            "cannot write {}: it is a folder; give a file name",
+            path.display()
+        ));
+    }
+    if let Some(h) = holder(path) {
+        return Err(held_error(path, &h));
+    }
+    std::fs::File::create(path).map_err(|e| write_error(path, e))
 }
 
 fn write_error(path: &Path, e: std::io::Error) -> super::error::EngineError {
@@ -44,6 +214,9 @@ pub fn write_atomically(
             "cannot write {}: it is a folder; give a file name",
             path.display()
         ));
+    }
+    if let Some(h) = holder(path) {
+        return Err(held_error(path, &h));
     }
     if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
         // A device or pipe (/dev/stdout, a FIFO) is written in place: renaming over it would
@@ -78,21 +251,36 @@ pub fn write_atomically(
     Ok(())
 }
 
-/// A file that rows are appended to as they are recorded, one whole line per write.
+/// A file that rows are appended to as they are recorded, one whole line per write; claimed
+/// while the stream lives.
 #[derive(Debug)]
 pub struct LineStream {
     file: std::fs::File,
     path: PathBuf,
+    claim: Claim,
 }
 
 impl LineStream {
-    /// Create (or truncate) `path` and write `first` lines into it.
-    pub fn create(path: &Path, first: &[String]) -> Result<Self> {
+    /// Create (or truncate) `path` and write `first` lines into it; `what` names the writer
+    /// ("a trajectory") for a second writer's error, `retiring` its owner's flag ([`Claim::take`]).
+    pub fn create(
+        path: &Path,
+        first: &[String],
+        what: &str,
+        retiring: Option<Arc<AtomicBool>>,
+    ) -> Result<Self> {
+        if path.as_os_str().is_empty() {
+            return Err(invalid!(
+                "cannot write a file with an empty name; give a path such as \"out/run.csv\""
+            ));
+        }
         ensure_parent(path)?;
+        let claim = Claim::take(path, what, retiring)?;
         let file = std::fs::File::create(path).map_err(|e| write_error(path, e))?;
         let mut s = LineStream {
             file,
             path: path.to_path_buf(),
+            claim,
         };
         for line in first {
             s.append(line)?;
@@ -100,9 +288,17 @@ impl LineStream {
         Ok(s)
     }
 
+    /// Whether this stream writes `path`.
+    pub fn is_at(&self, path: &Path) -> bool {
+        self.claim.is_on(path)
+    }
+
     /// Append one line (a newline is added) with a single write, so that the file never ends
-    /// in half a line.
+    /// in half a line. Nothing is written once another writer took the file over.
     pub fn append(&mut self, line: &str) -> Result<()> {
+        if self.claim.lost() {
+            return Ok(());
+        }
         let mut buf = String::with_capacity(line.len() + 1);
         buf.push_str(line);
         buf.push('\n');

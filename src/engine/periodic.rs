@@ -26,6 +26,15 @@ impl PeriodicBox {
                 ));
             }
         }
+        let volume = l[0] * l[1] * l[2];
+        if !(volume.is_normal()) {
+            return Err(invalid!(
+                "a box of sides {:e}, {:e}, {:e} m has a volume f64 cannot hold ({volume:e} m^3); give sides nearer the swimmers' size",
+                l[0],
+                l[1],
+                l[2]
+            ));
+        }
         Ok(PeriodicBox { l })
     }
 

@@ -229,6 +229,18 @@ impl Recorder {
         Ok(())
     }
 
+    /// This recorder in words, for messages: "the trajectory out/t.xyz", "the recorder of
+    /// R_H[0].x, R_H[0].y", or "the recorder of times only".
+    fn name(&self) -> String {
+        if let Some(t) = &self.frames {
+            return format!("the trajectory {}", t.path().display());
+        }
+        match self.columns().get(1..) {
+            Some(c) if !c.is_empty() => format!("the recorder of {}", c.join(", ")),
+            _ => "the recorder of times only".into(),
+        }
+    }
+
     /// Refuse, before a run from `t0` to `t_end`, a periodic trigger that the run cannot resolve
     /// or that would add more than [`MAX_ROWS_PER_RUN`] rows.
     pub fn check_run(&self, t0: f64, t_end: f64) -> Result<()> {
@@ -238,8 +250,8 @@ impl Recorder {
         let scale = t0.abs().max(t_end.abs()).max(self.start.abs());
         require_resolvable(
             &format!(
-                "the recorder of {} ({}, an interval of {dt:e} s)",
-                self.columns()[1..].join(", "),
+                "{} ({}, an interval of {dt:e} s)",
+                self.name(),
                 self.trigger.describe()
             ),
             dt,
@@ -250,8 +262,8 @@ impl Recorder {
         if rows > MAX_ROWS_PER_RUN {
             let values = rows * self.columns().len() as f64;
             return Err(invalid!(
-                "this run would add {rows:.3e} rows to the recorder of {} ({}), about {:.1} GB in memory; the limit is {MAX_ROWS_PER_RUN:e} rows per run: record less often, or split the run into shorter runs",
-                self.columns()[1..].join(", "),
+                "this run would add {rows:.3e} rows to {} ({}), about {:.1} GB in memory; the limit is {MAX_ROWS_PER_RUN:e} rows per run: record less often, or split the run into shorter runs",
+                self.name(),
                 self.trigger.describe(),
                 values * 8e-9
             ));
@@ -280,16 +292,32 @@ impl Recorder {
     /// Stream rows to `path` as CSV from now on: the file is created with the header and every
     /// row taken so far, then each new row is appended (one whole line, unbuffered) as it is
     /// taken. A kill loses no row already recorded; a later `stream_csv` moves the stream.
-    pub fn stream_csv(&mut self, path: &std::path::Path) -> Result<()> {
+    /// `retiring` is the owner's flag ([`super::files::Claim::take`]).
+    pub fn stream_csv(
+        &mut self,
+        path: &std::path::Path,
+        retiring: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ) -> Result<()> {
+        super::files::check_csv_name(path, "stream_csv")?;
         let mut lines = vec![csv_line(self.header())];
         lines.extend(self.rows.iter().map(|r| csv_line(r.iter().map(f64_field))));
-        self.stream = Some(LineStream::create(path, &lines)?);
+        // Moved onto the file it writes already: that claim is this recorder's own.
+        if self.stream.as_ref().is_some_and(|s| s.is_at(path)) {
+            self.stream = None;
+        }
+        self.stream = Some(LineStream::create(
+            path,
+            &lines,
+            "a recorder's CSV stream",
+            retiring,
+        )?);
         Ok(())
     }
 
     /// Write the rows as CSV with a header carrying names and units (to a temporary file renamed
     /// over `path`: a crash keeps the old file whole).
     pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
+        super::files::check_csv_name(path, "to_csv")?;
         write_atomically(path, |w| {
             let mut csv = csv::Writer::from_writer(w);
             csv.write_record(self.header())?;

@@ -11,8 +11,10 @@ use super::observable::Observable;
 use super::plan;
 use super::recorder::{Recorder, Trigger};
 use super::scene::Scene;
-use super::stepping::{Interrupt, Progress, RunControl, Workspace};
+use super::stepping::{Interrupt, Notice, Progress, RunControl, Workspace};
 use nalgebra::Vector3;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// A scene and what runs it. See the [module docs](self).
 #[derive(Debug, Default)]
@@ -22,6 +24,8 @@ pub struct Simulation {
     workspace: Workspace,
     probes: Workspace,
     control: RunControl,
+    /// Whether this simulation is being replaced: its recorders' files may be taken over.
+    retiring: Arc<AtomicBool>,
 }
 
 impl std::ops::Deref for Simulation {
@@ -67,6 +71,13 @@ impl Simulation {
         self.scene
     }
 
+    /// Mark this simulation as being replaced (a shell input declares its variable anew) or no
+    /// longer: while it is, a new writer on a file one of its recorders writes takes that file
+    /// over, and the recorder writes it no more ([`super::files::Claim`]).
+    pub fn set_retiring(&self, retiring: bool) {
+        self.retiring.store(retiring, Ordering::SeqCst);
+    }
+
     /// Stop runs (and probes) at a step boundary when `interrupt()` says so (`None`: never).
     pub fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
         self.control.set_interrupt(interrupt);
@@ -75,6 +86,12 @@ impl Simulation {
     /// Report progress to `p` during runs (`None`: no reports).
     pub fn set_progress(&mut self, p: Option<Progress>) {
         self.control.set_progress(p);
+    }
+
+    /// Tell `n` what a run says while it goes on: a cost far beyond what its length suggests,
+    /// and why (`None`: no one).
+    pub fn set_notice(&mut self, n: Option<Notice>) {
+        self.control.set_notice(n);
     }
 
     // ----- running -------------------------------------------------------------------------
@@ -93,7 +110,9 @@ impl Simulation {
     ///     for each recorder due at this time (steps end exactly on due times): take a row
     /// ```
     /// Recorders also take a row at the end of the run if their trigger is "at end". Rows taken
-    /// before an error or interrupt are kept.
+    /// before an error or interrupt are kept. A run whose cost will be far beyond what its length
+    /// suggests says so when it starts (a notice, [`Scene::cost_notices`]), and so does stroboscopic
+    /// averaging when it falls back to direct integration.
     pub fn run(&mut self, duration: f64) -> Result<()> {
         require_finite("duration", duration)?;
         if duration < 0.0 {
@@ -103,6 +122,12 @@ impl Simulation {
         }
         let t_end = self.scene.time() + duration;
         self.check_run(t_end)?;
+        self.control.begin_run();
+        if t_end > self.scene.time() {
+            for (kind, note) in self.scene.cost_notices() {
+                self.control.notice(kind, &note);
+            }
+        }
         loop {
             // Stop where a recorder wants a row, so nothing is evaluated between rows.
             let now = self.scene.time();
@@ -156,6 +181,19 @@ impl Simulation {
             .try_for_each(|r| r.fire(&self.scene, end_of_run, &mut probe))
     }
 
+    /// What the integrator in use runs on this scene ([`Scene::integrator_info`]), and what the
+    /// last run's stepper did that its name does not say (stroboscopic averaging that fell back
+    /// to direct integration, and why).
+    pub fn integrator_info(&self) -> Result<String> {
+        let info = self.scene.integrator_info()?;
+        Ok(
+            match self.workspace.stepper_report(self.scene.integrator()) {
+                Some(r) => format!("{info}; in the last run: {r}"),
+                None => info,
+            },
+        )
+    }
+
     /// Which backend the next run uses and why (see [`plan::backend_info`]).
     pub fn backend_info(&self) -> Result<String> {
         plan::backend_info(&self.scene)
@@ -190,7 +228,7 @@ impl Simulation {
     /// recorder that writes it (its rows are the frames' times).
     pub fn trajectory(&mut self, path: &std::path::Path, trigger: Trigger) -> Result<usize> {
         trigger.validate()?;
-        let t = super::trajectory::Trajectory::create(path)?;
+        let t = super::trajectory::Trajectory::create(path, Some(self.retiring.clone()))?;
         let mut probe = Probe::new(&mut self.probes, &self.control);
         let r = Recorder::start_trajectory(&self.scene, t, trigger, &mut probe)?;
         Ok(self.add_recorder(r))
@@ -207,6 +245,12 @@ impl Simulation {
         self.recorders
             .get(id)
             .ok_or_else(|| invalid!("recorder {id} does not belong to this scene"))
+    }
+
+    /// Stream the rows of recorder `id` to `path` as CSV from now on (see [`Recorder::stream_csv`]).
+    pub fn stream_csv(&mut self, id: usize, path: &std::path::Path) -> Result<()> {
+        let retiring = self.retiring.clone();
+        self.recorder_mut(id)?.stream_csv(path, Some(retiring))
     }
 
     /// A recorder by id, to change (e.g. to stream its rows).

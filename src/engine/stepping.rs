@@ -20,12 +20,20 @@ pub use super::integrators::Interrupt;
 /// device run segment, e.g. to draw a progress bar. It must be cheap.
 pub type Progress = Arc<dyn Fn(f64) + Send + Sync>;
 
-/// What every run takes besides the scene: whether to stop, and whom to tell the time. The
-/// default never stops and tells no one.
+/// Something a run says while it goes on, in engine words with its fixes as settings (the
+/// script layer shows them as script lines): a cost far beyond what the run's length suggests,
+/// and why. The payload is an [`EngineError`] for its message and fixes; the run goes on.
+pub type Notice = Arc<dyn Fn(&EngineError) + Send + Sync>;
+
+/// What every run takes besides the scene: whether to stop, whom to tell the time, and whom to
+/// tell a notice (each kind once a run). The default never stops and tells no one.
 #[derive(Clone, Default)]
 pub struct RunControl {
     interrupt: Option<Interrupt>,
     progress: Option<Progress>,
+    notice: Option<Notice>,
+    /// The kinds of notice given since the run began.
+    noticed: Arc<std::sync::Mutex<Vec<&'static str>>>,
 }
 
 impl std::fmt::Debug for RunControl {
@@ -33,6 +41,7 @@ impl std::fmt::Debug for RunControl {
         f.debug_struct("RunControl")
             .field("interrupt", &self.interrupt.is_some())
             .field("progress", &self.progress.is_some())
+            .field("notice", &self.notice.is_some())
             .finish()
     }
 }
@@ -46,6 +55,33 @@ impl RunControl {
     /// Report progress to `p` (`None`: no reports).
     pub fn set_progress(&mut self, p: Option<Progress>) {
         self.progress = p;
+    }
+
+    /// Tell `n` a run's notices (`None`: no one).
+    pub fn set_notice(&mut self, n: Option<Notice>) {
+        self.notice = n;
+    }
+
+    /// A run begins: every kind of notice may be given again.
+    pub fn begin_run(&self) {
+        if let Ok(mut k) = self.noticed.lock() {
+            k.clear();
+        }
+    }
+
+    /// Give the notice `e` of kind `kind`, unless one of that kind was given in this run.
+    pub fn notice(&self, kind: &'static str, e: &EngineError) {
+        let Some(n) = &self.notice else { return };
+        let fresh = self.noticed.lock().is_ok_and(|mut k| {
+            let fresh = !k.contains(&kind);
+            if fresh {
+                k.push(kind);
+            }
+            fresh
+        });
+        if fresh {
+            n(e);
+        }
     }
 
     /// Whether the run should stop now.
@@ -66,6 +102,8 @@ impl RunControl {
         RunControl {
             interrupt: self.interrupt.clone(),
             progress: None,
+            notice: None,
+            noticed: Arc::default(),
         }
     }
 }
@@ -93,6 +131,15 @@ impl Workspace {
     /// they hold no state between runs).
     pub fn forget_stepper(&mut self) {
         self.stepper = None;
+    }
+
+    /// What the stepper of the last run did that its name does not say ([`Stepper::report`]),
+    /// if that stepper was one for `spec`.
+    pub fn stepper_report(&self, spec: IntegratorSpec) -> Option<String> {
+        self.stepper
+            .as_ref()
+            .filter(|(s, _, _)| *s == spec)
+            .and_then(|(_, _, st)| st.report())
     }
 
     /// The cached stepper, reset, if it was built for `spec` and the scene key `key`; else a new
@@ -128,6 +175,7 @@ pub fn advance_cpu(
     stepper.set_interrupt(control.interrupt.clone());
     let mut outcome = Ok(());
     let mut taken = 0;
+    let fallbacks = s.stats.direct_fallbacks;
     while s.time < t_end && taken < max_steps {
         taken += 1;
         if control.interrupted() {
@@ -138,6 +186,14 @@ pub fn advance_cpu(
             Ok(t) => {
                 s.time = t;
                 control.report(s.time);
+                if s.stats.direct_fallbacks > fallbacks {
+                    if let Some(why) = stepper.report() {
+                        control.notice(
+                            "direct fallback",
+                            &EngineError::Invalid(format!("{spec}: {why}")),
+                        );
+                    }
+                }
             }
             // A long step given up on the interrupt.
             Err(_) if control.interrupted() => {

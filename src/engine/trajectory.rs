@@ -8,14 +8,25 @@
 //!   frame already written and never leaves half of one.
 //! - A ParaView series (`.pvd`): one VTK PolyData file (`.vtp`, written by the vtkio crate) per
 //!   frame in the folder `<name>_frames/` beside it, with the same data as point arrays (radius
-//!   and N for glyphs), and the `.pvd` collection listing every frame with its time, rewritten
-//!   whole (through a temporary file) after each frame.
+//!   and N for glyphs), and the `.pvd` collection listing every frame with its time. Each frame
+//!   costs the same however many came before: the `.vtp` is written under a temporary name in
+//!   the frames folder and renamed when whole (a frame's name only ever holds a whole frame),
+//!   then its entry and the collection's closing lines are written with one write over the old
+//!   closing lines. A kill leaves a `.pvd` that lists every whole frame and ends in its closing
+//!   lines, and at most the temporary file of the frame being written, inside the frames
+//!   folder, which the next trajectory of that name clears.
+//!
+//! A trajectory claims its file while it lives ([`super::files::Claim`]): a second one on the
+//! same path in this process is refused instead of mixing its frames into the first's.
 
 use super::error::{invalid, Result};
-use super::files::{ensure_parent, write_atomically, LineStream};
+use super::files::{ensure_parent, Claim, LineStream};
 use super::scene::Scene;
 use std::fmt::Write as _;
+use std::io::{Seek, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 /// Metres to the files' µm.
 const UM: f64 = 1e6;
@@ -29,6 +40,24 @@ pub enum Format {
     Pvd,
 }
 
+/// What holds a trajectory's file, for a second writer's error.
+const HOLDER: &str = "a trajectory";
+
+/// The `.pvd` collection's first lines.
+const PVD_HEAD: &str = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
+
+/// The `.pvd` collection's closing lines.
+const PVD_TAIL: &str = "  </Collection>\n</VTKFile>\n";
+
+/// A `.pvd` collection kept open, appended in place.
+#[derive(Debug)]
+struct Collection {
+    file: std::fs::File,
+    /// Where its closing lines start (bytes).
+    tail_at: u64,
+    claim: Claim,
+}
+
 /// A trajectory being written.
 #[derive(Debug)]
 pub struct Trajectory {
@@ -36,13 +65,16 @@ pub struct Trajectory {
     path: PathBuf,
     /// The XYZ stream.
     stream: Option<LineStream>,
-    /// Times and file names (relative to the `.pvd`) of the `.vtp` frames written.
-    frames: Vec<(f64, String)>,
+    /// The `.pvd` collection.
+    collection: Option<Collection>,
+    /// Frames written.
+    frames: usize,
 }
 
 impl Trajectory {
-    /// Start a trajectory at `path` (created or truncated): `.xyz` or `.pvd`.
-    pub fn create(path: &Path) -> Result<Self> {
+    /// Start a trajectory at `path` (created or truncated): `.xyz` or `.pvd`; `retiring` is its
+    /// owner's flag ([`Claim::take`]).
+    pub fn create(path: &Path, retiring: Option<Arc<AtomicBool>>) -> Result<Self> {
         let format = match path.extension().and_then(|e| e.to_str()) {
             Some("xyz") => Format::Xyz,
             Some("pvd") => Format::Pvd,
@@ -57,11 +89,16 @@ impl Trajectory {
             format,
             path: path.to_path_buf(),
             stream: None,
-            frames: Vec::new(),
+            collection: None,
+            frames: 0,
         };
         match format {
-            Format::Xyz => t.stream = Some(LineStream::create(path, &[])?),
+            Format::Xyz => t.stream = Some(LineStream::create(path, &[], HOLDER, retiring)?),
             Format::Pvd => {
+                ensure_parent(path)?;
+                // Claimed before anything is cleared: a second trajectory on this path must not
+                // remove the first one's frames.
+                let claim = Claim::take(path, HOLDER, retiring)?;
                 let dir = t.frame_dir();
                 if dir.exists() {
                     // Frames of an earlier trajectory of this name would mix with the new ones.
@@ -69,10 +106,22 @@ impl Trajectory {
                         invalid!("cannot clear the old frames in {}: {e}", dir.display())
                     })?;
                 }
-                t.write_collection()?;
+                let mut file = std::fs::File::create(path).map_err(|e| write_error(path, e))?;
+                file.write_all(format!("{PVD_HEAD}{PVD_TAIL}").as_bytes())
+                    .map_err(|e| write_error(path, e))?;
+                t.collection = Some(Collection {
+                    file,
+                    tail_at: PVD_HEAD.len() as u64,
+                    claim,
+                });
             }
         }
         Ok(t)
+    }
+
+    /// The trajectory's file.
+    pub fn path(&self) -> &Path {
+        &self.path
     }
 
     /// Where the `.vtp` frames of a `.pvd` go: `<name>_frames/` beside it.
@@ -84,8 +133,12 @@ impl Trajectory {
         self.path.with_file_name(format!("{stem}_frames"))
     }
 
-    /// Write the scene's spheres now as the next frame.
+    /// Write the scene's spheres now as the next frame (nothing, once another writer took the
+    /// file over).
     pub fn write_frame(&mut self, scene: &Scene) -> Result<()> {
+        if self.collection.as_ref().is_some_and(|c| c.claim.lost()) {
+            return Ok(());
+        }
         let spheres = Spheres::of(scene);
         match self.format {
             Format::Xyz => {
@@ -96,37 +149,58 @@ impl Trajectory {
             }
             Format::Pvd => {
                 let dir = self.frame_dir();
+                let file_name = format!("frame_{:06}.vtp", self.frames);
                 let name = format!(
-                    "{}/frame_{:06}.vtp",
-                    dir.file_name().map_or("".into(), |d| d.to_string_lossy()),
-                    self.frames.len()
+                    "{}/{file_name}",
+                    dir.file_name().map_or("".into(), |d| d.to_string_lossy())
                 );
-                let file = self.path.with_file_name(&name);
+                let file = dir.join(&file_name);
                 ensure_parent(&file)?;
                 let bytes = spheres.vtp()?;
-                write_atomically(&file, |w| w.write_all(&bytes))?;
-                self.frames.push((scene.time(), name));
-                self.write_collection()?;
+                // Whole under its own name, or not there: the temporary name is hidden and
+                // fixed, so a kill leaves at most this one.
+                let tmp = dir.join(format!(".{file_name}.tmp"));
+                std::fs::write(&tmp, &bytes)
+                    .and_then(|()| std::fs::rename(&tmp, &file))
+                    .map_err(|e| {
+                        let _ = std::fs::remove_file(&tmp);
+                        write_error(&file, e)
+                    })?;
+                self.append_entry(scene.time(), &name)?;
             }
         }
+        self.frames += 1;
         Ok(())
     }
 
-    /// The `.pvd` collection of the frames written so far.
-    fn write_collection(&self) -> Result<()> {
-        let mut xml = String::from(
-            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+    /// List a frame in the `.pvd`: its entry and the closing lines in one write over the old
+    /// closing lines, so the file always ends in them.
+    fn append_entry(&mut self, time: f64, name: &str) -> Result<()> {
+        let Some(c) = &mut self.collection else {
+            return Ok(());
+        };
+        let mut text = String::new();
+        let _ = writeln!(
+            text,
+            "    <DataSet timestep=\"{time:?}\" group=\"\" part=\"0\" file=\"{}\"/>",
+            xml_escape(name)
         );
-        for (t, name) in &self.frames {
-            let _ = writeln!(
-                xml,
-                "    <DataSet timestep=\"{t:?}\" group=\"\" part=\"0\" file=\"{}\"/>",
-                xml_escape(name)
-            );
-        }
-        xml.push_str("  </Collection>\n</VTKFile>\n");
-        write_atomically(&self.path, |w| w.write_all(xml.as_bytes()))
+        let entry = text.len() as u64;
+        text.push_str(PVD_TAIL);
+        c.file
+            .seek(SeekFrom::Start(c.tail_at))
+            .and_then(|_| c.file.write_all(text.as_bytes()))
+            .map_err(|e| write_error(&self.path, e))?;
+        c.tail_at += entry;
+        Ok(())
     }
+}
+
+fn write_error(path: &Path, e: std::io::Error) -> super::error::EngineError {
+    invalid!(
+        "cannot write {}: {e}; check that the folder is writable and the disk not full",
+        path.display()
+    )
 }
 
 fn xml_escape(s: &str) -> String {

@@ -19,39 +19,20 @@ pub(super) fn register_font() {
     });
 }
 
-/// A drawing error as a message: a backend (file) error names the cause and the fix; anything
-/// else is plotters' own text.
+/// A drawing error as a message. Pictures are drawn in memory (files are written apart, by
+/// [`crate::engine::files`]), so this is plotters' own text.
 pub(super) fn err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
-    match e {
-        DrawingAreaErrorKind::BackendError(inner) => {
-            let text = inner.to_string();
-            let text = text.trim_start_matches("Drawing backend error: ");
-            format!(
-                "cannot write the picture: {text}; check that the folder exists and is writable"
-            )
-        }
-        other => format!("cannot draw the picture: {other}"),
-    }
+    format!("cannot draw the picture: {e}")
 }
 
 /// Draw `f` to `path` in `format`.
 pub(super) fn figure(f: &Figure, path: &Path, format: Format) -> Result<(), String> {
-    register_font();
-    match format {
-        Format::Svg => {
-            let root = SVGBackend::new(path, (f.width, f.height)).into_drawing_area();
-            draw_figure(f, &root)?;
-            root.present().map_err(err)
-        }
-        Format::Png => {
-            let root = BitMapBackend::new(path, (f.width, f.height)).into_drawing_area();
-            draw_figure(f, &root)?;
-            root.present().map_err(err)
-        }
-    }
+    to_file((f.width, f.height), f, path, format)
 }
 
-/// Draw `picture` of `size` to `path` in `format`.
+/// Draw `picture` of `size` to `path` in `format`: drawn in memory, then written whole through a
+/// temporary file and a rename, as every file swimlab writes (a crash keeps the old picture, and
+/// a path that cannot be written gets the message that names it and the fix).
 pub(super) fn to_file(
     size: (u32, u32),
     picture: &dyn Drawable,
@@ -59,18 +40,27 @@ pub(super) fn to_file(
     format: Format,
 ) -> Result<(), String> {
     register_font();
-    match format {
+    let bytes = match format {
         Format::Svg => {
-            let root = SVGBackend::new(path, size).into_drawing_area();
-            picture.draw_svg(&root)?;
-            root.present().map_err(err)
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                picture.draw_svg(&root)?;
+                root.present().map_err(err)?;
+            }
+            svg.into_bytes()
         }
         Format::Png => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            picture.draw_bitmap(&root)?;
-            root.present().map_err(err)
+            let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+                picture.draw_bitmap(&root)?;
+                root.present().map_err(err)?;
+            }
+            encode_png(&rgb, size)?
         }
-    }
+    };
+    crate::engine::files::write_atomically(path, |w| w.write_all(&bytes)).map_err(|e| e.to_string())
 }
 
 /// A picture drawn in memory by `draw` onto an SVG and a bitmap of `size`: the SVG text and the
@@ -378,46 +368,68 @@ pub(super) struct ScenePicture<'a> {
     pub view: Option<(f64, f64, f64, f64)>,
 }
 
-/// An animated GIF of scene pictures, a frame per [`Film::frame`].
+/// An animated GIF of scene pictures, a frame per [`Film::frame`], each written to the file as
+/// it is drawn (the gif crate's encoder on the file: a run stopped early leaves the frames so far).
 pub(super) struct Film {
-    root: DrawingArea<BitMapBackend<'static>, Shift>,
+    encoder: gif::Encoder<std::fs::File>,
+    path: std::path::PathBuf,
+    size: (u32, u32),
+    /// Between frames, in hundredths of a second (GIF's unit).
+    delay: u16,
 }
 
 impl Film {
     /// A GIF at `path`, `size` pixels, `delay_ms` between frames.
     pub(super) fn create(path: &Path, size: (u32, u32), delay_ms: u32) -> Result<Self, String> {
         register_font();
-        let backend = BitMapBackend::gif(path, size, delay_ms).map_err(|e| {
-            format!("cannot write the picture: {e}; check that the folder exists and is writable")
-        })?;
+        let file = crate::engine::files::create(path).map_err(|e| e.to_string())?;
+        let gif_error = |e: gif::EncodingError| gif_error(path, e);
+        let mut encoder =
+            gif::Encoder::new(file, size.0 as u16, size.1 as u16, &[]).map_err(gif_error)?;
+        encoder
+            .set_repeat(gif::Repeat::Infinite)
+            .map_err(gif_error)?;
         Ok(Film {
-            root: backend.into_drawing_area(),
+            encoder,
+            path: path.to_path_buf(),
+            size,
+            delay: ((delay_ms + 5) / 10).min(u16::MAX as u32) as u16,
         })
     }
 
     /// Draw `p` as the next frame; returns the region it showed (to hold it for the next ones).
     pub(super) fn frame(&mut self, p: &ScenePicture) -> Result<(f64, f64, f64, f64), String> {
-        let view = draw_scene(p, &self.root)?;
-        self.root.present().map_err(err)?;
+        let (w, h) = self.size;
+        let mut rgb = vec![0u8; w as usize * h as usize * 3];
+        let view = {
+            let root = BitMapBackend::with_buffer(&mut rgb, self.size).into_drawing_area();
+            let view = draw_scene(p, &root)?;
+            root.present().map_err(err)?;
+            view
+        };
+        let mut frame = gif::Frame::from_rgb_speed(w as u16, h as u16, &rgb, 10);
+        frame.delay = self.delay;
+        self.encoder
+            .write_frame(&frame)
+            .map_err(|e| gif_error(&self.path, e))?;
         Ok(view)
+    }
+}
+
+/// A GIF encoder's error as a message naming the file and the fix.
+fn gif_error(path: &Path, e: gif::EncodingError) -> String {
+    match e {
+        gif::EncodingError::Io(e) => format!(
+            "cannot write {}: {e}; check that the folder is writable and the disk not full",
+            path.display()
+        ),
+        other => format!("cannot encode the GIF {}: {other}", path.display()),
     }
 }
 
 /// Draw a scene picture to `path`.
 pub(super) fn scene(p: &ScenePicture, path: &Path, format: Format) -> Result<(), String> {
-    register_font();
-    match format {
-        Format::Svg => {
-            let root = SVGBackend::new(path, p.size).into_drawing_area();
-            draw_scene(p, &root)?;
-            root.present().map_err(err)
-        }
-        Format::Png => {
-            let root = BitMapBackend::new(path, p.size).into_drawing_area();
-            draw_scene(p, &root)?;
-            root.present().map_err(err)
-        }
-    }
+    to_file(p.size, p, path, format)
 }
 
 /// Draw `p`; returns the region shown (x0, x1, y0, y1) in µm.

@@ -129,12 +129,15 @@ impl Session {
             Err(e) => return Err(render_error(name, source, &e.into())),
         };
         let merged = self.functions.merge(&ast);
+        let replaced = self.set_aside_replaced(&ast);
         let result = self
             .engine
             .eval_ast_with_scope::<Dynamic>(&mut self.scope, &merged);
+        self.settle_replaced(replaced);
         // Keep the functions even when the statements failed: they were defined.
         self.functions = merged;
         self.functions.clear_statements();
+        self.drop_shadowed();
         if result.is_ok() {
             self.keep_imports(source);
         }
@@ -144,6 +147,80 @@ impl Session {
             Ok(v) if v.is_unit() || quiet => Ok(None),
             Ok(v) => Ok(Some(v)),
             Err(e) => Err(render_error(name, source, &e)),
+        }
+    }
+
+    /// The variables `ast` declares anew at its top level before anything in it mentions them (a
+    /// notebook cell run again: `let s = scene(); s.trajectory("t.xyz", 1);`), taken out of the
+    /// scope for the run: nothing in it could read them. A scene among them is marked as being
+    /// replaced, so that a new writer may take over the files its recorders write. Each comes
+    /// back with its constness.
+    fn set_aside_replaced(&mut self, ast: &AST) -> Vec<(String, bool, Dynamic)> {
+        let mut out = Vec::new();
+        for name in declared_before_use(ast) {
+            let Some(constant) = self
+                .scope
+                .iter_raw()
+                .filter(|(n, ..)| *n == name)
+                .map(|(_, c, _)| c)
+                // The newest of that name: the one the input hides.
+                .next()
+            else {
+                continue;
+            };
+            let Some(value) = self.scope.remove::<Dynamic>(&name) else {
+                continue;
+            };
+            if let Some(h) = value.read_lock::<script::SceneHandle>() {
+                h.borrow().set_retiring(true);
+            }
+            out.push((name, constant, value));
+        }
+        out
+    }
+
+    /// After the run: a variable set aside and declared anew is dropped; one the run did not get
+    /// to declare (it failed first) comes back as it was.
+    fn settle_replaced(&mut self, replaced: Vec<(String, bool, Dynamic)>) {
+        for (name, constant, value) in replaced {
+            if self.scope.contains(&name) {
+                continue;
+            }
+            if let Some(h) = value.read_lock::<script::SceneHandle>() {
+                h.borrow().set_retiring(false);
+            }
+            if constant {
+                self.scope.push_constant_dynamic(name, value);
+            } else {
+                self.scope.push_dynamic(name, value);
+            }
+        }
+    }
+
+    /// Drop the variables a later `let` of the same name hid: nothing reaches them by name any
+    /// more, and a scene among them would keep its memory, and its recorders the files they
+    /// write.
+    fn drop_shadowed(&mut self) {
+        // Oldest first (the scope iterates from the newest).
+        let mut entries: Vec<(String, bool, Dynamic)> = self
+            .scope
+            .iter_raw()
+            .map(|(n, c, v)| (n.to_string(), c, v.clone()))
+            .collect();
+        entries.reverse();
+        let last = |k: usize| !entries[k + 1..].iter().any(|(n, ..)| *n == entries[k].0);
+        if (0..entries.len()).all(last) {
+            return;
+        }
+        let kept: Vec<usize> = (0..entries.len()).filter(|&k| last(k)).collect();
+        self.scope.clear();
+        for k in kept {
+            let (name, constant, value) = entries[k].clone();
+            if constant {
+                self.scope.push_constant_dynamic(name, value);
+            } else {
+                self.scope.push_dynamic(name, value);
+            }
         }
     }
 
@@ -361,5 +438,38 @@ fn help_overview() -> String {
         out.push_str(&format!("\n  {c:<12} {what}"));
     }
     out.push_str("\n\nCtrl-C stops a running simulation (the scene is kept); Ctrl-D leaves.");
+    out
+}
+
+/// The names `ast` declares with a top-level `let` or `const` before any statement mentions them
+/// (a read anywhere in an earlier statement, closures included, or in the declaration's own
+/// value).
+fn declared_before_use(ast: &AST) -> Vec<String> {
+    use rhai::{ASTNode, Expr, Stmt};
+    let mut mentioned: Vec<String> = Vec::new();
+    let mut out = Vec::new();
+    for stmt in ast.statements() {
+        let mut reads = Vec::new();
+        let mut path = Vec::new();
+        stmt.walk(&mut path, &mut |p: &[ASTNode]| {
+            match p.last() {
+                Some(ASTNode::Expr(Expr::Variable(x, ..))) => reads.push(x.1.to_string()),
+                // Variables a closure captures.
+                Some(ASTNode::Stmt(Stmt::Share(x))) => {
+                    reads.extend(x.iter().map(|(v, _)| v.name.to_string()))
+                }
+                _ => {}
+            }
+            true
+        });
+        if let Stmt::Var(x, ..) = stmt {
+            let name = x.0.name.to_string();
+            if !mentioned.contains(&name) && !reads.contains(&name) && !out.contains(&name) {
+                out.push(name.clone());
+            }
+            mentioned.push(name);
+        }
+        mentioned.extend(reads);
+    }
     out
 }

@@ -128,7 +128,12 @@ pub fn piped(input: impl BufRead, out: &mut dyn Write, err: &mut dyn Write) -> b
             Reply::Quit => return ok,
             Reply::Output(s) if s.is_empty() => {}
             Reply::Output(s) => {
-                let _ = writeln!(out, "{s}");
+                // A reader that has gone reads no more values: end quietly, as `print` does.
+                if let Err(e) = writeln!(out, "{s}") {
+                    if e.kind() == std::io::ErrorKind::BrokenPipe {
+                        std::process::exit(crate::script::console::CLOSED_STDOUT_STATUS);
+                    }
+                }
             }
             Reply::Error(s) => {
                 ok = false;

@@ -1,7 +1,8 @@
 //! Text that script functions write themselves (a text plot), to standard output or to a front
 //! end's own sink (a notebook's stdout stream); values shown by `display(value)`, as text or
-//! through a front end's display sink (a notebook shows a picture inline). Rhai's `print` goes
-//! through the session's `on_print`, which a notebook points at the same stream.
+//! through a front end's display sink (a notebook shows a picture inline); notes a run gives
+//! while it goes on, to standard error or a front end's note sink. Rhai's `print` goes through
+//! the session's `on_print`, which a notebook points at the same stream.
 
 use std::io::Write;
 use std::sync::{Arc, Mutex};
@@ -54,6 +55,28 @@ pub fn set_display_sink(sink: Option<DisplaySink>) {
     DISPLAY.set(sink);
 }
 
+static NOTE: Hook<TextSink> = Hook::new();
+
+/// Send notes (what a run says while it goes on) to `sink` (or standard error again, given
+/// `None`).
+pub fn set_note_sink(sink: Option<TextSink>) {
+    NOTE.set(sink);
+}
+
+/// Tell the user `text` as a note ("note: ..." on standard error, or a front end's note sink):
+/// not a result, so never on standard output, where it would mix with a script's own output.
+pub fn note(text: &str) {
+    let line = format!("note: {text}\n");
+    match NOTE.get() {
+        Some(f) => f(&line),
+        None => {
+            let mut err = std::io::stderr().lock();
+            let _ = err.write_all(line.as_bytes());
+            let _ = err.flush();
+        }
+    }
+}
+
 /// Show `v` now: through the display sink, else as the shell shows values.
 pub fn display(v: &rhai::Dynamic) {
     match DISPLAY.get() {
@@ -66,10 +89,31 @@ pub fn display(v: &rhai::Dynamic) {
 pub fn write(text: &str) {
     match SINK.get() {
         Some(f) => f(text),
-        None => {
-            let mut out = std::io::stdout().lock();
-            let _ = out.write_all(text.as_bytes());
-            let _ = out.flush();
+        None => to_stdout(text),
+    }
+}
+
+/// The exit status of a process whose standard output was closed under it: the one a shell
+/// gives a process that SIGPIPE ended (128 + 13).
+pub const CLOSED_STDOUT_STATUS: i32 = 141;
+
+/// Write `text` to standard output, flushed. When its reader has gone (`swimlab run s.rhai |
+/// head -1`), nothing more written could be read: the process ends at once, quietly, with
+/// [`CLOSED_STDOUT_STATUS`], as command-line tools do (files written so far are whole: every
+/// writer renames or appends whole lines). Any other failure (a full disk) is told once on
+/// standard error; the script goes on, its printed text lost.
+pub fn to_stdout(text: &str) {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    static TOLD: AtomicBool = AtomicBool::new(false);
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(CLOSED_STDOUT_STATUS);
+        }
+        if !TOLD.swap(true, Ordering::SeqCst) {
+            note(&format!(
+                "cannot write standard output ({e}): what the script prints is lost; check where it is redirected"
+            ));
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Conversions between Rhai values and engine values, with errors that say what was expected.
 
+pub use super::types::describe;
 use crate::engine::error::Setting;
 use crate::engine::EngineError;
 use nalgebra::Vector3;
@@ -7,16 +8,6 @@ use rhai::{Array, Dynamic, EvalAltResult, Position, FLOAT, INT};
 
 /// Result type of script-visible functions.
 pub type ScriptResult<T> = Result<T, Box<EvalAltResult>>;
-
-/// Register a script type's `to_string` and `to_debug` as its `Display`: the one text `print`,
-/// string interpolation, `debug` and the REPL's `show` give.
-pub fn register_display<T: std::fmt::Display + Clone + Send + Sync + 'static>(
-    engine: &mut rhai::Engine,
-) {
-    engine
-        .register_fn("to_string", |x: &mut T| x.to_string())
-        .register_fn("to_debug", |x: &mut T| x.to_string());
-}
 
 /// A runtime error with this message; Rhai fills in the script position of the call.
 pub fn script_error(msg: impl Into<String>) -> Box<EvalAltResult> {
@@ -40,6 +31,8 @@ pub fn setting_in_script(s: &Setting) -> String {
         Setting::Mobility(m) => format!("s.mobility = \"{m}\""),
         Setting::NoNoise => "s.temperature = 0".into(),
         Setting::NoiseIntegrator => "s.integrator = euler(dt) or platen(dt)".into(),
+        Setting::EwaldMethod(m) => format!("s.ewald_method = \"{m}\""),
+        Setting::LooserEwaldTol => "a looser s.ewald_tol (e.g. 1e-6)".into(),
     }
 }
 
@@ -66,9 +59,8 @@ pub fn number(what: &str, v: &Dynamic) -> ScriptResult<f64> {
         Ok(i as f64)
     } else {
         Err(script_error(format!(
-            "{what} must be a number, got {} ({})",
-            v,
-            v.type_name()
+            "{what} must be a number, got {}",
+            describe(v)
         )))
     }
 }
@@ -77,9 +69,8 @@ pub fn number(what: &str, v: &Dynamic) -> ScriptResult<f64> {
 pub fn vector3(what: &str, v: &Dynamic) -> ScriptResult<Vector3<f64>> {
     let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
         script_error(format!(
-            "{what} must be an array of 3 numbers such as [1.0, 0.0, 0.0], got {} ({})",
-            v,
-            v.type_name()
+            "{what} must be an array of 3 numbers such as [1.0, 0.0, 0.0], got {}",
+            describe(v)
         ))
     })?;
     if arr.len() != 3 {

@@ -1,8 +1,8 @@
 //! `write_csv(path, rows)` / `write_csv(path, columns, rows)`: tables from scripts.
 
-use super::convert::{script_error, ScriptResult};
+use super::convert::{describe, script_error, ScriptResult};
 use super::docs::{doc_entry, Doc};
-use crate::engine::files::write_atomically;
+use crate::engine::files::{check_csv_name, write_atomically};
 use rhai::{Array, Dynamic, Engine, Map};
 use std::path::Path;
 
@@ -32,6 +32,7 @@ pub fn write_table(path: &str, columns: &[String], rows: &[Map]) -> ScriptResult
             .collect::<ScriptResult<_>>()?;
         records.push(record);
     }
+    super::convert::lift(check_csv_name(Path::new(path), "write_csv"))?;
     super::convert::lift(write_atomically(Path::new(path), |w| {
         let mut csv = csv::Writer::from_writer(w);
         csv.write_record(columns)?;
@@ -46,10 +47,10 @@ fn maps(rows: Array) -> ScriptResult<Vec<Map>> {
     rows.into_iter()
         .enumerate()
         .map(|(k, r)| {
-            let t = r.type_name();
+            let got = describe(&r);
             r.try_cast::<Map>().ok_or_else(|| {
                 script_error(format!(
-                    "write_csv: row {k} must be an object map such as #{{ D: 10.0, drift: 1e-6 }}, got {t}"
+                    "write_csv: row {k} must be an object map such as #{{ D: 10.0, drift: 1e-6 }}, got {got}"
                 ))
             })
         })
@@ -81,6 +82,6 @@ pub(super) const DOCS: &[Doc] = &[doc_entry!(
     "write_csv",
     "files",
     "write_csv(path, rows)\nwrite_csv(path, columns, rows)",
-    "Write an array of maps as CSV (columns in the given order, or sorted).",
+    "Write an array of maps as CSV (columns in the given order, or sorted). A name ending in another format's extension (.png, .svg, .gif, .vti, .vtp, .pvd, .xyz, .json, ...) is refused: CSV text under it would open in no program for that format.",
     "write_csv(\"out/help/t.csv\", [\"D\", \"v\"], [#{ D: 10.0, v: 1e-6 }]);"
 )];

@@ -78,9 +78,7 @@ impl std::fmt::Display for DumbbellSpec {
 
 /// Register the `Dumbbell` type and `dumbbell(...)`.
 pub fn register(engine: &mut Engine) {
-    super::convert::register_display::<DumbbellSpec>(engine);
     engine
-        .register_type_with_name::<DumbbellSpec>("Dumbbell")
         .register_fn("dumbbell", |m: Map| DumbbellSpec::from_map(&m))
         .register_fn("dumbbell", DumbbellSpec::default)
         .register_fn("phase", |x: rhai::Dynamic| -> ScriptResult<f64> {

@@ -3,7 +3,7 @@
 use super::{
     csv_api, dumbbell_api, field_api, float_cmp, integrator_api, interrupt, limits, observable_api,
     panic_guard::guard, params, picture_api, plot_api, render_error, scene_api, stdlib, sweep_api,
-    util_api,
+    types, util_api, wrong_calls,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -19,9 +19,19 @@ pub fn engine() -> Engine {
 /// The engine of [`engine()`] and the stdlib modules it compiled, for a caller that resolves
 /// imports itself (the REPL keeps imports across inputs) without compiling them again.
 pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResolver) {
+    let (mut engine, embedded) = vocabulary_engine();
+    wrong_calls::register(&mut engine);
+    (engine, embedded)
+}
+
+/// The engine of [`engine()`] without the forms that answer calls no registered form takes
+/// (`wrong_calls`): its metadata is the vocabulary those forms, `:help` and the error messages
+/// are built from.
+pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModuleResolver) {
     let mut engine = Engine::new();
     engine.set_max_expr_depths(256, 256);
     limits::apply(&mut engine);
+    types::register(&mut engine);
     dumbbell_api::register(&mut engine);
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);
@@ -35,6 +45,9 @@ pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResol
     field_api::register(&mut engine);
     params::register_defaults(&mut engine);
     let embedded = stdlib::install(&mut engine);
+    // `print` as every other text a script writes: a closed standard output ends the process
+    // quietly (Rhai's own `println!` would panic).
+    engine.on_print(|s| super::console::to_stdout(&format!("{s}\n")));
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
     (engine, embedded)

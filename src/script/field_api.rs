@@ -2,7 +2,7 @@
 //! `.to_vtk(path)`, `.plot(...)`, `.stat(name)`), `s.structure_factor([#{ bins, k_max }])`, and
 //! the recorder observable `field_stat(kind, stat[, opts])`.
 
-use super::convert::{lift, number, register_display, script_error, ScriptResult};
+use super::convert::{describe, lift, number, script_error, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use super::picture_api::Picture;
 use super::scene_api::SceneHandle;
@@ -21,13 +21,15 @@ fn spec(opts: &Map) -> ScriptResult<FieldSpec> {
                 let arr = v.clone().try_cast::<Array>().filter(|a| a.len() == 3);
                 let Some(arr) = arr else {
                     return Err(script_error(format!(
-                        "field grid must be three cell counts such as [32, 32, 32], got {v}"
+                        "field grid must be three cell counts such as [32, 32, 32], got {}",
+                        describe(v)
                     )));
                 };
                 for (d, x) in arr.iter().enumerate() {
-                    let n = x.as_int().map_err(|t| {
+                    let n = x.as_int().map_err(|_| {
                         script_error(format!(
-                            "field grid[{d}] must be a whole number, got {x} ({t})"
+                            "field grid[{d}] must be a whole number, got {}",
+                            describe(x)
                         ))
                     })?;
                     s.grid[d] = usize::try_from(n).unwrap_or(0);
@@ -62,9 +64,10 @@ fn heat_map(f: &Field, opts: &Map) -> ScriptResult<HeatMap> {
     for (k, v) in opts {
         match k.as_str() {
             "axis" => {
-                let name = v.clone().into_immutable_string().map_err(|t| {
+                let name = v.clone().into_immutable_string().map_err(|_| {
                     script_error(format!(
-                        "plot axis must be \"x\", \"y\" or \"z\", got {v} ({t})"
+                        "plot axis must be \"x\", \"y\" or \"z\", got {}",
+                        describe(v)
                     ))
                 })?;
                 axis = match name.as_str() {
@@ -81,8 +84,11 @@ fn heat_map(f: &Field, opts: &Map) -> ScriptResult<HeatMap> {
                 }
             }
             "index" => {
-                let i = v.as_int().map_err(|t| {
-                    script_error(format!("plot index must be a whole number, got {v} ({t})"))
+                let i = v.as_int().map_err(|_| {
+                    script_error(format!(
+                        "plot index must be a whole number, got {}",
+                        describe(v)
+                    ))
                 })?;
                 index = Some(usize::try_from(i).map_err(|_| {
                     script_error(format!("plot index {i} is negative; cells start at 0"))
@@ -159,9 +165,10 @@ fn structure(s: &SceneHandle, opts: &Map) -> ScriptResult<Map> {
     for (k, v) in opts {
         match k.as_str() {
             "bins" => {
-                let b = v.as_int().map_err(|t| {
+                let b = v.as_int().map_err(|_| {
                     script_error(format!(
-                        "structure_factor bins must be a whole number, got {v} ({t})"
+                        "structure_factor bins must be a whole number, got {}",
+                        describe(v)
                     ))
                 })?;
                 bins = usize::try_from(b).unwrap_or(0);
@@ -210,7 +217,6 @@ impl std::fmt::Display for Field {
 /// Register `Field`, `s.field`, `s.structure_factor` and `field_stat`.
 pub fn register(engine: &mut Engine) {
     engine
-        .register_type_with_name::<Field>("Field")
         .register_fn("field", |s: &mut SceneHandle, k: &str| field_of(s, k, &Map::new()))
         .register_fn("field", |s: &mut SceneHandle, k: &str, o: Map| field_of(s, k, &o))
         .register_get("values", |f: &mut Field| values(f))
@@ -245,7 +251,6 @@ pub fn register(engine: &mut Engine) {
         .register_fn("structure_factor", |s: &mut SceneHandle, o: Map| structure(s, &o))
         .register_fn("field_stat", |k: &str, st: &str| field_stat(k, st, &Map::new()))
         .register_fn("field_stat", |k: &str, st: &str, o: Map| field_stat(k, st, &o));
-    register_display::<Field>(engine);
 }
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].

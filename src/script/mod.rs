@@ -26,7 +26,9 @@ mod show;
 mod signatures;
 pub mod stdlib;
 mod sweep_api;
+mod types;
 mod util_api;
+mod wrong_calls;
 
 pub use convert::{engine_message, script_error, setting_in_script, ScriptResult};
 
@@ -35,6 +37,7 @@ pub fn suggest_name(word: &str) -> Option<&'static str> {
     let names: Vec<&'static str> = docs::DOCS.iter().map(|d| d.name).collect();
     convert::suggest(word, &names)
 }
+pub use crate::engine::gpu::quiet_device_selection;
 pub use dumbbell_api::DumbbellSpec;
 pub use engine_builder::{
     engine, engine_and_stdlib, eval_expression, read_text, run_file, run_file_with, run_source,

@@ -1,7 +1,7 @@
 //! Observables as script values (type `Observable`), `s.observe(obs)`, triggers (type `Trigger`),
 //! and recorders (type `Recorder`): `s.record([...], trigger)`, `.rows`, `.to_csv(path)`.
 
-use super::convert::{index, lift, number, register_display, script_error, vector3, ScriptResult};
+use super::convert::{describe, index, lift, number, script_error, vector3, ScriptResult};
 use super::docs::{self, doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::{Observable, Recorder, Trigger};
@@ -11,7 +11,7 @@ use rhai::{Array, Dynamic, Engine, ImmutableString, Map, INT};
 /// A script's handle on one recorder of a scene.
 #[derive(Debug, Clone)]
 pub struct RecorderHandle {
-    scene: SceneHandle,
+    pub(super) scene: SceneHandle,
     id: usize,
 }
 
@@ -68,8 +68,8 @@ fn trigger_of(v: &Dynamic) -> ScriptResult<Trigger> {
         return Ok(Trigger::EveryPeriods(number("record(..., every)", v)?));
     }
     Err(script_error(format!(
-        "the trigger must be a number of periods or every_periods(n), every_seconds(t), at_times([..]), at_end(); got {v} ({})",
-        v.type_name()
+        "the trigger must be a number of periods or every_periods(n), every_seconds(t), at_times([..]), at_end(); got {}",
+        describe(v)
     )))
 }
 
@@ -79,9 +79,8 @@ fn observables_of(list: &Array) -> ScriptResult<Vec<Observable>> {
         .map(|(k, o)| {
             o.clone().try_cast::<Observable>().ok_or_else(|| {
                 script_error(format!(
-                    "record: element {k} is not an observable (got {} ({})); use R_H(0), q(0, 1), polarization(), ...",
-                    o,
-                    o.type_name()
+                    "record: element {k} is not an observable (got {}); use R_H(0), q(0, 1), polarization(), ...",
+                    describe(o)
                 ))
             })
         })
@@ -90,11 +89,7 @@ fn observables_of(list: &Array) -> ScriptResult<Vec<Observable>> {
 
 /// Register observables, triggers and recorders.
 pub fn register(engine: &mut Engine) {
-    register_display::<Observable>(engine);
-    register_display::<Trigger>(engine);
-    register_display::<RecorderHandle>(engine);
     engine
-        .register_type_with_name::<Observable>("Observable")
         .register_get("name", |o: &mut Observable| o.name())
         .register_get("unit", |o: &mut Observable| o.unit().to_string());
 
@@ -166,12 +161,11 @@ pub fn register(engine: &mut Engine) {
         .register_fn(
             "observe",
             |s: &mut SceneHandle, o: Observable| -> ScriptResult<Dynamic> {
-                lift(s.borrow_mut().measure(&o)).map(value)
+                lift(s.borrow_to_measure().measure(&o)).map(value)
             },
         );
 
     engine
-        .register_type_with_name::<Trigger>("Trigger")
         .register_fn("every_periods", |n: Dynamic| -> ScriptResult<Trigger> {
             let t = Trigger::EveryPeriods(number("every_periods(n): n", &n)?);
             lift(t.validate()).map(|_| t)
@@ -192,13 +186,12 @@ pub fn register(engine: &mut Engine) {
         .register_fn("at_end", || Trigger::AtEnd);
 
     engine
-        .register_type_with_name::<RecorderHandle>("Recorder")
         .register_fn(
             "record",
             |s: &mut SceneHandle, list: Array, every: Dynamic| -> ScriptResult<RecorderHandle> {
                 let obs = observables_of(&list)?;
                 let trigger = trigger_of(&every)?;
-                let id = lift(s.borrow_mut().record(obs, trigger))?;
+                let id = lift(s.borrow_mut()?.record(obs, trigger))?;
                 Ok(RecorderHandle {
                     scene: s.clone(),
                     id,
@@ -213,7 +206,7 @@ pub fn register(engine: &mut Engine) {
              -> ScriptResult<RecorderHandle> {
                 let trigger = trigger_of(&every)?;
                 let id = lift(
-                    s.borrow_mut()
+                    s.borrow_mut()?
                         .trajectory(std::path::Path::new(path.as_str()), trigger),
                 )?;
                 Ok(RecorderHandle {
@@ -271,11 +264,10 @@ pub fn register(engine: &mut Engine) {
         .register_fn(
             "stream_csv",
             |r: &mut RecorderHandle, path: &str| -> ScriptResult<()> {
-                let mut scene = r.scene.borrow_mut();
                 lift(
-                    scene
-                        .recorder_mut(r.id)
-                        .and_then(|rec| rec.stream_csv(std::path::Path::new(path))),
+                    r.scene
+                        .borrow_mut()?
+                        .stream_csv(r.id, std::path::Path::new(path)),
                 )
             },
         )
@@ -309,15 +301,15 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("min_gap", "observables", "min_gap() -> Observable", "The smallest gap between the surfaces of any two spheres of the scene (m): how close the closest approach is. Through cell lists from 1,024 spheres (all pairs when the scene is too sparse for them to be sure), parallel for large scenes.", "let s = scene(); s.add(dumbbell(#{})); s.add(dumbbell(#{ center: [2e-5, 0.0, 0.0] })); print(s.observe(min_gap()));"),
     doc_entry!("nematic", "observables", "nematic() -> Observable", "Largest eigenvalue of Q = <3NN - I>/2.", "let s = scene(); s.add(dumbbell()); print(s.observe(nematic()));"),
     doc_entry!("record", "recording", "s.record([obs, ...], every) -> Recorder", "Record observables on a trigger: a number (every n periods), every_periods(n), every_seconds(t), at_times([..]) or at_end(). Periodic recorders take a row at once. Only the recorded observables are evaluated, only at their times.", docs::PAIR_RECORD),
-    doc_entry!("trajectory", "recording", "s.trajectory(path, every) -> Recorder", "Write the spheres frame by frame as the runs go, on a trigger as s.record takes (a number of periods, every_periods, every_seconds, at_times, at_end), for particle viewers: path.xyz is extended XYZ (ASE, OVITO: one particle per sphere, positions and radius in um, swimmer index, sphere 1 or 2, orientation N, the time in s on each comment line), each frame appended with one write when it is due, so a kill or Ctrl-C loses no frame already written; path.pvd is a ParaView series, one .vtp file per frame in the folder <name>_frames beside it (point arrays radius, swimmer, sphere, N for glyphs) and the .pvd listing them with their times. The recorder's rows are the frames' times.", "let s = scene(); s.add(dumbbell()); let t = s.trajectory(\"out/help/pair.xyz\", 0.5); s.run_periods(1); print(t.len);"),
+    doc_entry!("trajectory", "recording", "s.trajectory(path, every) -> Recorder", "Write the spheres frame by frame as the runs go, on a trigger as s.record takes (a number of periods, every_periods, every_seconds, at_times, at_end), for particle viewers: path.xyz is extended XYZ (ASE, OVITO: one particle per sphere, positions and radius in um, swimmer index, sphere 1 or 2, orientation N, the time in s on each comment line), each frame appended with one write when it is due, so a kill or Ctrl-C loses no frame already written; path.pvd is a ParaView series, one .vtp file per frame in the folder <name>_frames beside it (point arrays radius, swimmer, sphere, N for glyphs) and the .pvd listing them with their times, appended in place (a kill leaves it listing whole frames). One writer per file: a path another trajectory or CSV stream of this session writes is refused (an input that declares the other's scene anew, a cell run again, lets it go). The recorder's rows are the frames' times.", "let s = scene(); s.add(dumbbell()); let t = s.trajectory(\"out/help/pair.xyz\", 0.5); s.run_periods(1); print(t.len);"),
     doc_entry!("every_periods", "recording", "every_periods(n) -> Trigger", "Every n periods from now.", "print(every_periods(2));"),
     doc_entry!("every_seconds", "recording", "every_seconds(t) -> Trigger", "Every t seconds from now.", "print(every_seconds(1e-3));"),
     doc_entry!("at_times", "recording", "at_times([t1, t2, ...]) -> Trigger", "At the given absolute times (s).", "print(at_times([0.01, 0.02]));"),
     doc_entry!("at_end", "recording", "at_end() -> Trigger", "At the end of every run.", "print(at_end());"),
     doc_entry!("rows", "recording", "rec.rows -> array of maps", "The recorded rows, keyed by column name (time, R_H[0].x, ...).", docs::PAIR_ROWS),
     doc_entry!("columns", "recording", "rec.columns -> array\nrec.header -> array\nrec.column(name) -> array", "Column names (without / with units) and one column's values.", docs::PAIR_COLUMNS),
-    doc_entry!("stream_csv", "recording", "rec.stream_csv(path)", "From now on append every row to path as CSV the moment it is recorded (one whole line per row, unbuffered; the file starts with the header and the rows so far). A kill or Ctrl-C loses no row already recorded.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); r.stream_csv(\"out/help/stream.csv\"); s.run_periods(2);"),
-    doc_entry!("to_csv", "recording", "rec.to_csv(path)", "Write the rows as CSV; the header carries names and units. Folders are created; the file is written whole to a temporary file and renamed, so a crash keeps the old one.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); s.run_periods(1); r.to_csv(\"out/help/r.csv\");"),
+    doc_entry!("stream_csv", "recording", "rec.stream_csv(path)", "From now on append every row to path as CSV the moment it is recorded (one whole line per row, unbuffered; the file starts with the header and the rows so far). A kill or Ctrl-C loses no row already recorded. A path another CSV stream or trajectory of this session writes is refused. A name ending in another format's extension (.png, .svg, .gif, .vti, .vtp, .pvd, .xyz, .json, ...) is refused: CSV text under it would open in no program for that format.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); r.stream_csv(\"out/help/stream.csv\"); s.run_periods(2);"),
+    doc_entry!("to_csv", "recording", "rec.to_csv(path)", "Write the rows as CSV; the header carries names and units. Folders are created; the file is written whole to a temporary file and renamed, so a crash keeps the old one. A name ending in another format's extension (.png, .svg, .gif, .vti, .vtp, .pvd, .xyz, .json, ...) is refused: CSV text under it would open in no program for that format.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); s.run_periods(1); r.to_csv(\"out/help/r.csv\");"),
     doc_entry!("name", "observables", "obs.name -> string\nobs.unit -> string", "An observable's name (its column prefix) and unit.", "print(q(0, 1).name); print(R_H(0).unit);"),
     doc_entry!("unit", "observables", "obs.unit -> string", "An observable's unit (m, N, ell, or 1).", "print(D_H(0, 1).unit);"),
     doc_entry!("len", "recording", "rec.len -> int", "Number of rows recorded.", "let s = scene(); s.add(dumbbell()); let r = s.record([R_H(0)], 1); s.run_periods(2); print(r.len);"),

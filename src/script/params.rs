@@ -27,12 +27,7 @@ pub fn parse_set(item: &str) -> Result<(String, Dynamic), String> {
     let (name, value) = item
         .split_once('=')
         .ok_or_else(|| format!("error: --set {item}: expected NAME=VALUE, such as --set D=10"))?;
-    let valid = name
-        .chars()
-        .next()
-        .is_some_and(|c| c.is_alphabetic() || c == '_')
-        && name.chars().all(|c| c.is_alphanumeric() || c == '_');
-    if !valid {
+    if !valid_name(name) {
         return Err(format!(
             "error: --set {item}: \"{name}\" is not a valid variable name (letters, digits, _)"
         ));
@@ -49,14 +44,33 @@ pub fn parse_set(item: &str) -> Result<(String, Dynamic), String> {
     Ok((name.to_string(), v))
 }
 
+/// Whether `name` can be a `--set` name: a variable name (a letter or _, then letters, digits, _).
+fn valid_name(name: &str) -> bool {
+    name.chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_alphanumeric() || c == '_')
+}
+
 /// Register `param(name, default)`: the `--set` value of `name` if one was given, else `default`.
+/// A name that no `--set` can give (empty, or not a variable name) is refused: the script would
+/// always run its default.
 pub fn register(engine: &mut Engine, sets: &Sets) {
     let sets: Vec<(String, Dynamic)> = sets.to_vec();
-    engine.register_fn("param", move |name: &str, default: Dynamic| {
-        sets.iter()
-            .find(|(n, _)| n == name)
-            .map_or(default, |(_, v)| v.clone())
-    });
+    engine.register_fn(
+        "param",
+        move |name: &str, default: Dynamic| -> super::ScriptResult<Dynamic> {
+            if !valid_name(name) {
+                return Err(super::script_error(format!(
+                    "param(\"{name}\", ...): the name must be a variable name (a letter or _, then letters, digits, _), as --set NAME=VALUE gives it, such as param(\"D\", 10.0)"
+                )));
+            }
+            Ok(sets
+                .iter()
+                .find(|(n, _)| n == name)
+                .map_or(default, |(_, v)| v.clone()))
+        },
+    );
 }
 
 /// Register `param(name, default)` without any `--set` values (the shell, `-e`, tests).
@@ -173,5 +187,5 @@ pub fn check(ast: &AST, sets: &Sets) -> Result<(), (Position, String)> {
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[
-    doc_entry!("param", "running", "param(name, default) -> value", "The value given by swimlab run --set name=VALUE, or default without one: let D = param(\"D\", 10.0); lets a cluster job choose D. A --set name the script never reads, or hides with its own let, is an error.", "let D = param(\"D\", 10.0); print(D);"),
+    doc_entry!("param", "running", "param(name, default) -> value", "The value given by swimlab run --set name=VALUE, or default without one: let D = param(\"D\", 10.0); lets a cluster job choose D. A --set name the script never reads, or hides with its own let, is an error, and so is a name no --set can give (empty, or not a variable name).", "let D = param(\"D\", 10.0); print(D);"),
 ];

@@ -2,7 +2,7 @@
 //! a `Picture`, drawn in memory as PNG and SVG. A notebook shows it inline; the REPL shows what
 //! it is; `pic.save(path)` writes it.
 
-use super::convert::{register_display, script_error, ScriptResult};
+use super::convert::{script_error, ScriptResult};
 use super::docs::doc_entry;
 use super::docs::Doc;
 use crate::plot::Image;
@@ -56,10 +56,8 @@ impl std::fmt::Display for Picture {
 /// Register the `Picture` type.
 pub fn register(engine: &mut Engine) {
     engine
-        .register_type_with_name::<Picture>("Picture")
         .register_fn("save", |p: &mut Picture, path: &str| p.save(path))
         .register_fn("display", |v: rhai::Dynamic| super::console::display(&v));
-    register_display::<Picture>(engine);
 }
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].

@@ -5,7 +5,7 @@
 //! (x defaults to 0, 1, 2, ...; color to the series' index in the palette); options are a
 //! map `#{ title, x_label, y_label, log_x, log_y, width, height }` (and `cols`, `rows` for text).
 
-use super::convert::{lift, number, script_error, ScriptResult};
+use super::convert::{describe, lift, number, script_error, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
 use super::picture_api::Picture;
@@ -17,10 +17,12 @@ use crate::plot::{
 use rhai::{Array, Dynamic, Engine, Map, INT};
 
 fn numbers(what: &str, v: &Dynamic) -> ScriptResult<Vec<f64>> {
-    let arr = v
-        .clone()
-        .try_cast::<Array>()
-        .ok_or_else(|| script_error(format!("{what} must be an array of numbers, got {v}")))?;
+    let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
+        script_error(format!(
+            "{what} must be an array of numbers, got {}",
+            describe(v)
+        ))
+    })?;
     arr.iter()
         .enumerate()
         .map(|(i, x)| number(&format!("{what}[{i}]"), x))
@@ -31,19 +33,20 @@ fn text(what: &str, v: &Dynamic) -> ScriptResult<String> {
     v.clone()
         .into_immutable_string()
         .map(|s| s.to_string())
-        .map_err(|_| script_error(format!("{what} must be a string, got {v}")))
+        .map_err(|_| script_error(format!("{what} must be a string, got {}", describe(v))))
 }
 
 fn flag(what: &str, v: &Dynamic) -> ScriptResult<bool> {
     v.as_bool()
-        .map_err(|_| script_error(format!("{what} must be true or false, got {v}")))
+        .map_err(|_| script_error(format!("{what} must be true or false, got {}", describe(v))))
 }
 
 fn pixels(what: &str, v: &Dynamic) -> ScriptResult<u32> {
     let n = number(what, v)?;
     if n.fract() != 0.0 || !(1.0..=1e5).contains(&n) {
         return Err(script_error(format!(
-            "{what} must be a whole number of pixels, got {v}"
+            "{what} must be a whole number of pixels, got {}",
+            describe(v)
         )));
     }
     Ok(n as u32)
@@ -66,7 +69,8 @@ fn series_of(k: usize, m: &Map) -> ScriptResult<Series> {
             "color" => {
                 let c = v.as_int().map_err(|_| {
                     script_error(format!(
-                        "series {k}: color must be a palette index 0-9, got {v}"
+                        "series {k}: color must be a palette index 0-9, got {}",
+                        describe(v)
                     ))
                 })?;
                 s.color = Some(c.rem_euclid(crate::plot::COLORS.len() as rhai::INT) as usize);
@@ -100,7 +104,8 @@ fn all_series(v: &Dynamic) -> ScriptResult<Vec<Series>> {
     }
     let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
         script_error(format!(
-            "plot series must be a map #{{ x: [..], y: [..] }} or an array of them, got {v}"
+            "plot series must be a map #{{ x: [..], y: [..] }} or an array of them, got {}",
+            describe(v)
         ))
     })?;
     arr.iter()
@@ -108,7 +113,8 @@ fn all_series(v: &Dynamic) -> ScriptResult<Vec<Series>> {
         .map(|(k, s)| {
             let m = s.clone().try_cast::<Map>().ok_or_else(|| {
                 script_error(format!(
-                    "series {k} must be a map #{{ x: [..], y: [..] }}, got {s}"
+                    "series {k} must be a map #{{ x: [..], y: [..] }}, got {}",
+                    describe(s)
                 ))
             })?;
             series_of(k, &m)
@@ -182,7 +188,8 @@ fn recorder_figure(r: &RecorderHandle, x: &str, ys: &Dynamic) -> ScriptResult<Fi
     } else {
         let arr = ys.clone().try_cast::<Array>().ok_or_else(|| {
             script_error(format!(
-                "y columns must be a name or an array of names, got {ys}"
+                "y columns must be a name or an array of names, got {}",
+                describe(ys)
             ))
         })?;
         arr.iter()
@@ -265,7 +272,10 @@ fn animate(s: &mut SceneHandle, path: &str, opts: &Map) -> ScriptResult<INT> {
             "periods" => periods = number("animate: periods", v)?,
             "frames" => {
                 frames = v.as_int().map_err(|_| {
-                    script_error(format!("animate: frames must be a whole number, got {v}"))
+                    script_error(format!(
+                        "animate: frames must be a whole number, got {}",
+                        describe(v)
+                    ))
                 })?
             }
             "fps" => fps = number("animate: fps", v)?,
@@ -300,7 +310,7 @@ fn animate(s: &mut SceneHandle, path: &str, opts: &Map) -> ScriptResult<INT> {
             // Frame k at t0 + k/frames of the run: no rounding accumulates over the frames.
             let target = t0 + duration * k as f64 / frames as f64;
             let now = s.borrow().time();
-            lift(s.borrow_mut().run((target - now).max(0.0)))?;
+            lift(s.borrow_mut()?.run((target - now).max(0.0)))?;
         }
         film.frame(&s.borrow())
             .map_err(|e| script_error(format!("animate \"{path}\": {e}")))?;

@@ -10,7 +10,8 @@ use rhai::{EvalAltResult, Position};
 
 /// Render a script error against its source text.
 pub fn render_error(name: &str, source: &str, err: &EvalAltResult) -> String {
-    let d = describe(err);
+    let mut d = describe(err);
+    d.msg = super::types::in_words(&d.msg);
     let mut out = String::new();
     match d.pos.line() {
         Some(line) => {
@@ -30,6 +31,12 @@ pub fn render_error(name: &str, source: &str, err: &EvalAltResult) -> String {
         }
     }
     out
+}
+
+/// The message of `err` as [`render_error`] words it, without its position (for an error quoted
+/// inside another's message).
+pub fn message_of(err: &EvalAltResult) -> String {
+    super::types::in_words(&describe(err).msg)
 }
 
 /// The source line and a caret under column `col` (1-based, counted in characters as Rhai does).
@@ -77,7 +84,12 @@ fn describe(err: &EvalAltResult) -> Described {
     match err {
         EvalAltResult::ErrorInFunctionCall(f, src, inner, pos) => {
             let d = describe(inner);
-            let f = f.as_str();
+            // A closure's function has a generated name ("anon$5f3c..."), which says nothing.
+            let f = if f.starts_with("anon$") {
+                "the closure"
+            } else {
+                f.as_str()
+            };
             if !src.is_empty() && src != "<input>" {
                 // The inner position is in the module `src`; the user's position is the call.
                 let module = d.module.or_else(|| Some((src.clone(), d.pos)));
@@ -154,7 +166,7 @@ fn integer_hint(call: &str, args: &[String], forms: &[String]) -> String {
 }
 
 /// "run_period (Scene, i64)" → a message with the closest name, or the accepted forms.
-fn function_not_found(sig: &str) -> String {
+pub(super) fn function_not_found(sig: &str) -> String {
     let (name, args) = match sig.split_once(" (") {
         Some((n, a)) => (n.trim(), a.trim_end_matches(')')),
         None => (sig.trim(), ""),
@@ -165,6 +177,26 @@ fn function_not_found(sig: &str) -> String {
         args.split(", ").map(shown_type).collect()
     };
     let call = format!("{name}({})", args.join(", "));
+    if name.starts_with("anon$") {
+        // A closure (its function's generated name says nothing) called with a number of
+        // arguments other than its parameters'.
+        let n = args.len();
+        let params = match n {
+            1 => "p".to_string(),
+            _ => (1..=n)
+                .map(|k| format!("p{k}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        };
+        let s = if n == 1 { "" } else { "s" };
+        return format!(
+            "a closure was called with {n} argument{s} ({}), which its parameters do not take; write it with {n} parameter{s}, such as |{params}| ...",
+            args.join(", ")
+        );
+    }
+    if is_operator(name) {
+        return operator_not_found(name, &args);
+    }
     let voc = vocabulary();
     if let Some((alias, f)) = name.rsplit_once("::") {
         // A module function: look for it (or the closest name) in every stdlib module, since
@@ -209,6 +241,31 @@ fn function_not_found(sig: &str) -> String {
         ),
         None => format!("there is no function {call}; :help lists every name"),
     }
+}
+
+/// Whether `name` is an operator (`/`, `+=`, `<`, ...) rather than a function name.
+fn is_operator(name: &str) -> bool {
+    !name.is_empty() && !name.chars().any(|c| c.is_alphanumeric() || c == '_')
+}
+
+/// An operator that has no form for these operand types: "cannot apply / to float and string".
+fn operator_not_found(op: &str, args: &[String]) -> String {
+    let operands = match args {
+        [a] => format!("a {a}"),
+        [a, b] => format!("{a} and {b}"),
+        _ => args.join(", "),
+    };
+    let numeric = ["+", "-", "*", "/", "%", "**", "<", "<=", ">", ">="]
+        .iter()
+        .any(|o| op.trim_end_matches('=') == *o || op == *o);
+    let fix = if args.iter().any(|a| a == "string") && numeric {
+        "; a number was given as a string: write 2, not \"2\" (parse_float(s) or parse_int(s) converts)"
+    } else if numeric {
+        "; both sides must be numbers (int or float)"
+    } else {
+        ""
+    };
+    format!("the operator {op} cannot be applied to {operands}{fix}")
 }
 
 fn module_not_found(m: &str) -> String {

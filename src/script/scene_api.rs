@@ -5,12 +5,13 @@
 //! `let t = s;` names the same scene, as in Python. Every run of a script's scene stops on Ctrl-C
 //! ([`interrupt`]).
 
-use super::convert::{array3, index, lift, number, script_error, ScriptResult};
+use super::convert::{array3, describe, index, lift, number, script_error, ScriptResult};
 use super::docs::{self, doc_entry, Doc};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
 use crate::engine::{Backend, Scene, Simulation};
 use rhai::{Array, Dynamic, Engine, INT};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 /// The largest scene file `load_scene` reads (bytes): a saved scene of 10^5 swimmers is ~60 MB.
@@ -18,7 +19,23 @@ pub const MAX_SCENE_FILE_BYTES: u64 = 256 << 20;
 
 /// A script's handle on a scene and its simulation (Rhai type `Scene`).
 #[derive(Debug, Clone)]
-pub struct SceneHandle(pub Arc<RwLock<Simulation>>);
+pub struct SceneHandle {
+    sim: Arc<RwLock<Simulation>>,
+    /// The sweeps whose calls share this scene now: while any does, it can be read, not changed.
+    shared_by_sweeps: Arc<AtomicUsize>,
+}
+
+/// While this lives, the scenes it holds are shared by the calls of a sweep (see
+/// [`SceneHandle::borrow_mut`]).
+pub(super) struct SweepShare(Vec<SceneHandle>);
+
+impl Drop for SweepShare {
+    fn drop(&mut self) {
+        for h in &self.0 {
+            h.shared_by_sweeps.fetch_sub(1, Ordering::SeqCst);
+        }
+    }
+}
 
 impl Default for SceneHandle {
     fn default() -> Self {
@@ -31,18 +48,54 @@ impl SceneHandle {
     pub fn new(scene: Scene) -> Self {
         let mut sim = Simulation::new(scene);
         sim.set_interrupt(Some(Arc::new(interrupt::requested)));
-        SceneHandle(Arc::new(RwLock::new(sim)))
+        sim.set_notice(Some(Arc::new(|e: &crate::engine::EngineError| {
+            super::console::note(&super::engine_message(e))
+        })));
+        SceneHandle {
+            sim: Arc::new(RwLock::new(sim)),
+            shared_by_sweeps: Arc::default(),
+        }
+    }
+
+    /// Whether `other` is a handle on the same scene.
+    pub(super) fn same(&self, other: &SceneHandle) -> bool {
+        Arc::ptr_eq(&self.sim, &other.sim)
+    }
+
+    /// Mark `scenes` as shared by the calls of a sweep for as long as the result lives.
+    pub(super) fn share_in_sweep(scenes: Vec<SceneHandle>) -> SweepShare {
+        for h in &scenes {
+            h.shared_by_sweeps.fetch_add(1, Ordering::SeqCst);
+        }
+        SweepShare(scenes)
     }
 
     /// Read the simulation (and through it the scene). A lock poisoned by a panic elsewhere still
     /// holds a consistent one (every change is made whole or not at all), so it is read anyway.
     pub fn borrow(&self) -> RwLockReadGuard<'_, Simulation> {
-        self.0.read().unwrap_or_else(|e| e.into_inner())
+        self.sim.read().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Change the simulation.
-    pub fn borrow_mut(&self) -> RwLockWriteGuard<'_, Simulation> {
-        self.0.write().unwrap_or_else(|e| e.into_inner())
+    /// Change the simulation; refused while the calls of a sweep share the scene: they run at once
+    /// on several threads, and changes from them would race (results changing from run to run).
+    pub fn borrow_mut(&self) -> ScriptResult<RwLockWriteGuard<'_, Simulation>> {
+        if self.shared_by_sweeps.load(Ordering::SeqCst) > 0 {
+            return Err(script_error(
+                "this scene is shared by every call of the sweep (captured by its closure, or given in more than one parameter), and the calls run at once on several threads: changing it from them would race, and the results would change from run to run; a call may read it, not change it: build the scene inside the closure, or change a copy there (let t = s.copy(); t.run_periods(1); ...)",
+            ));
+        }
+        Ok(self.write())
+    }
+
+    /// The simulation to measure with (a probe runs copies, and keeps its buffers in the
+    /// simulation): a reading, allowed while a sweep shares the scene; the lock keeps the calls'
+    /// measurements one at a time.
+    pub(super) fn borrow_to_measure(&self) -> RwLockWriteGuard<'_, Simulation> {
+        self.write()
+    }
+
+    fn write(&self) -> RwLockWriteGuard<'_, Simulation> {
+        self.sim.write().unwrap_or_else(|e| e.into_inner())
     }
 
     pub(super) fn with<T>(
@@ -57,30 +110,31 @@ impl SceneHandle {
         &self,
         f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
-        lift(f(self.borrow_mut().scene_mut()))
+        lift(f(self.borrow_mut()?.scene_mut()))
     }
 
-    /// Run or measure.
+    /// Run.
     fn with_sim<T>(
         &self,
         f: impl FnOnce(&mut Simulation) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
-        lift(f(&mut self.borrow_mut()))
+        lift(f(&mut *self.borrow_mut()?))
     }
 
     /// Put `trial` in place of the scene (the recorders stay); returns the new count.
-    fn replace(&self, trial: Scene) -> INT {
-        let mut sim = self.borrow_mut();
+    fn replace(&self, trial: Scene) -> ScriptResult<INT> {
+        let mut sim = self.borrow_mut()?;
         sim.replace_scene(trial);
-        sim.count() as INT
+        Ok(sim.count() as INT)
     }
 }
 
 fn swimmer_index(v: &Dynamic) -> ScriptResult<usize> {
     match v.as_int() {
         Ok(i) => index(i),
-        Err(t) => Err(script_error(format!(
-            "a swimmer index must be an integer such as 0, got {v} ({t})"
+        Err(_) => Err(script_error(format!(
+            "a swimmer index must be an integer such as 0, got {}",
+            describe(v)
         ))),
     }
 }
@@ -195,19 +249,36 @@ fn add_random(
         seed as u64,
         gap,
     ))?;
-    Ok(s.replace(trial))
+    s.replace(trial)
 }
 
 /// `s.add_at(d, centres)`: a copy of d (its orientation and phase) at every centre of the array,
 /// in order; all or nothing (the scene is unchanged if one does not fit).
 fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult<INT> {
-    let mut trial = s.borrow().scene().clone();
+    // The centres up to the first that is not a point; the swimmers before it are checked
+    // first, as adding them one by one would.
+    let mut items = Vec::with_capacity(centres.len());
+    let mut unreadable = None;
     for (k, c) in centres.iter().enumerate() {
-        let c = super::convert::vector3(&format!("add_at: centre {k}"), c)?;
-        lift(trial.add(d.params, c, d.dir))
-            .map_err(|e| script_error(format!("add_at: centre {k}: {e}")))?;
+        match super::convert::vector3(&format!("add_at: centre {k}"), c) {
+            Ok(c) => items.push((d.params, c, d.dir)),
+            Err(e) => {
+                unreadable = Some(e);
+                break;
+            }
+        }
     }
-    Ok(s.replace(trial))
+    let mut trial = s.borrow().scene().clone();
+    trial.add_many(&items).map_err(|(k, e)| {
+        script_error(format!(
+            "add_at: centre {k}: {}",
+            super::convert::engine_message(&e)
+        ))
+    })?;
+    if let Some(e) = unreadable {
+        return Err(e);
+    }
+    s.replace(trial)
 }
 
 /// Run `f` with a progress bar over the next `duration` seconds (only at a terminal).
@@ -231,10 +302,7 @@ fn with_bar<T>(
 
 /// Register the `Scene` type and its methods and properties.
 pub fn register(engine: &mut Engine) {
-    engine
-        .register_type_with_name::<SceneHandle>("Scene")
-        .register_fn("scene", SceneHandle::default);
-    super::convert::register_display::<SceneHandle>(engine);
+    engine.register_fn("scene", SceneHandle::default);
 
     // Building.
     engine.register_fn(
@@ -248,8 +316,8 @@ pub fn register(engine: &mut Engine) {
         "add",
         |_: &mut SceneHandle, d: Dynamic| -> ScriptResult<INT> {
             Err(script_error(format!(
-                "add expects a Dumbbell such as dumbbell(#{{ phase: 0.0 }}), got {d} ({})",
-                d.type_name()
+                "add expects a Dumbbell such as dumbbell(#{{ phase: 0.0 }}), got {}",
+                describe(&d)
             )))
         },
     );
@@ -384,8 +452,8 @@ pub fn register(engine: &mut Engine) {
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 let arr = v.clone().try_cast::<Array>().ok_or_else(|| {
                     script_error(format!(
-                        "phases must be an array of numbers, got {v} ({})",
-                        v.type_name()
+                        "phases must be an array of numbers, got {}",
+                        describe(&v)
                     ))
                 })?;
                 let ph = arr
@@ -461,6 +529,14 @@ pub fn register(engine: &mut Engine) {
             m.insert("micro_periods".into(), (st.micro_periods as INT).into());
             m.insert("noisy_steps".into(), (st.noisy_steps as INT).into());
             m.insert("refined_steps".into(), (st.refined_steps as INT).into());
+            m.insert(
+                "direct_fallbacks".into(),
+                (st.direct_fallbacks as INT).into(),
+            );
+            m.insert(
+                "fallback_periods".into(),
+                (st.fallback_periods as INT).into(),
+            );
             m
         })
         .register_fn(
@@ -498,7 +574,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
     doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
     doc_entry!("diffusion", "thermal", "s.diffusion(i) -> map", "Swimmer i's diffusion as a rigid dumbbell of length ell at the scene's temperature and mobility: parallel and perpendicular translation D_par, D_perp (m^2/s), their orientation average translation = (D_par + 2 D_perp)/3 (a centre's mean squared displacement grows as 6 translation t), rotation D_r (1/s), and offset: where along N from R_H translation and rotation decouple (m). All zero at 0 K. The averaged model's noise; for a symmetric dumbbell translation equals kT/(12 pi mu)(1/a + 1/ell).", "let s = scene(); s.add(dumbbell()); s.temperature = 300; print(s.diffusion(0).translation);"),
-    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations; macro_steps and micro_periods of stroboscopic averaging; noisy_steps, the steps taken with thermal noise (also the noise generator's counter); refined_steps, the short steps suspension(tol) took for a few swimmers inside its steps.", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
+    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations; macro_steps and micro_periods of stroboscopic averaging, and direct_fallbacks and fallback_periods, the times its macro steps failed at their shortest length and the periods it then integrated directly (s.integrator_info says why); noisy_steps, the steps taken with thermal noise (also the noise generator's counter); refined_steps, the short steps suspension(tol) took for a few swimmers inside its steps.", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
     doc_entry!("sphere_velocities", "reading", "s.sphere_velocities(forces) -> [[vx, vy, vz], ...]", "Sphere velocities (m/s) for given forces (N): one [fx, fy, fz] per sphere, swimmer by swimmer, the a1 sphere first; the scene's mobility and viscosity at the present sphere positions, Stokes drag included. For checks against other codes; the scene does not move.", "let s = scene(); s.add(dumbbell()); print(s.sphere_velocities([[1e-12, 0, 0], [0, 0, 0]]));"),
     doc_entry!("center", "reading", "s.center(i) -> [x, y, z]", "Hydrodynamic centre R_H of swimmer i (m).", "let s = scene(); s.add(dumbbell()); print(s.center(0));"),
     doc_entry!("dir", "reading", "s.dir(i) -> [x, y, z]", "Unit orientation N of swimmer i (from the a1 sphere to the a2 sphere).", "let s = scene(); s.add(dumbbell(#{ dir: [0, 1, 0] })); print(s.dir(0));"),

@@ -2,7 +2,7 @@
 //! `s.coefficients`, `s.overlaps`, each read from its engine table), `s.steric`, `s.cutoff`,
 //! `s.integrator`, and the read-only `time`, `count`, `period`, `stiff_rate`, `backend_info`.
 
-use super::convert::{lift, number, script_error, unknown_choice, ScriptResult};
+use super::convert::{describe, lift, number, script_error, unknown_choice, ScriptResult};
 use super::docs::{doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::choice::{self, Named};
@@ -18,7 +18,7 @@ fn string_arg(what: &str, v: &Dynamic) -> ScriptResult<String> {
     v.clone()
         .into_immutable_string()
         .map(|s| s.to_string())
-        .map_err(|t| script_error(format!("{what} must be a string, got {v} ({t})")))
+        .map_err(|_| script_error(format!("{what} must be a string, got {}", describe(v))))
 }
 
 /// `s.steric = #{ range, stiffness[, body] }` (m, N/m, "spheres" or "rods") or `()` for none.
@@ -29,7 +29,8 @@ fn steric_arg(v: &Dynamic) -> ScriptResult<Option<Steric>> {
     }
     let Some(map) = v.clone().try_cast::<rhai::Map>() else {
         return Err(script_error(format!(
-            "s.steric must be a map or (), got {v}; {FIX}"
+            "s.steric must be a map or (), got {}; {FIX}",
+            describe(v)
         )));
     };
     let (mut range, mut stiffness, mut body) = (None, None, StericBody::Spheres);
@@ -76,7 +77,7 @@ fn register_choice<T: Named + Send + Sync>(
                 let name = string_arg(property, &v)?;
                 let value = lift(choice::parse::<T>(&name))?;
                 check(value)?;
-                set(s.borrow_mut().scene_mut(), value);
+                set(s.borrow_mut()?.scene_mut(), value);
                 Ok(())
             },
         );
@@ -167,10 +168,11 @@ pub fn register(engine: &mut Engine) {
                     .and_then(|i| u64::try_from(i).ok())
                     .ok_or_else(|| {
                         script_error(format!(
-                            "seed must be a whole number of 0 or more, got {v}; e.g. s.seed = 42"
+                            "seed must be a whole number of 0 or more, got {}; e.g. s.seed = 42",
+                            describe(&v)
                         ))
                     })?;
-                s.borrow_mut().scene_mut().set_seed(seed);
+                s.borrow_mut()?.scene_mut().set_seed(seed);
                 Ok(())
             },
         )
@@ -212,7 +214,7 @@ pub fn register(engine: &mut Engine) {
             None => Dynamic::UNIT,
         })
         .register_set("steric", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-            s.borrow_mut().scene_mut().set_steric(steric_arg(&v)?);
+            s.borrow_mut()?.scene_mut().set_steric(steric_arg(&v)?);
             Ok(())
         })
         .register_get("cutoff", |s: &mut SceneHandle| {
@@ -242,18 +244,18 @@ pub fn register(engine: &mut Engine) {
         })
         .register_get("integrator", |s: &mut SceneHandle| s.borrow().integrator())
         .register_get("integrator_info", |s: &mut SceneHandle| {
-            s.with(|sc| sc.integrator_info()).map(ImmutableString::from)
+            super::convert::lift(s.borrow().integrator_info()).map(ImmutableString::from)
         })
         .register_set(
             "integrator",
             |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
                 if let Some(spec) = v.clone().try_cast::<IntegratorSpec>() {
-                    s.borrow_mut().scene_mut().set_integrator(Some(spec));
+                    s.borrow_mut()?.scene_mut().set_integrator(Some(spec));
                     return Ok(());
                 }
                 match v.clone().into_immutable_string() {
                     Ok(name) if name == "default" => {
-                        s.borrow_mut().scene_mut().set_integrator(None);
+                        s.borrow_mut()?.scene_mut().set_integrator(None);
                         Ok(())
                     }
                     Ok(name) => match METHODS.iter().find(|m| m.name == name.as_str()) {
@@ -263,9 +265,10 @@ pub fn register(engine: &mut Engine) {
                         ))),
                         None => Err(unknown_choice("integrator", &name, &["default"])),
                     },
-                    Err(t) => Err(script_error(format!(
-                        "integrator must be {} or \"default\", got {v} ({t})",
-                        super::integrator_api::call_forms()
+                    Err(_) => Err(script_error(format!(
+                        "integrator must be {} or \"default\", got {}",
+                        super::integrator_api::call_forms(),
+                        describe(&v)
                     ))),
                 }
             },
@@ -281,11 +284,11 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("overlaps", "numerics", "s.overlaps -> string\ns.overlaps = \"stop\" | \"allow\"", "What happens when spheres of different swimmers touch: \"stop\" (default) ends the run with an error naming them; \"allow\" lets them overlap, moved by the RPY tensor for overlapping spheres (Zuk et al. 2014, positive definite; the averaged model, a far-field model, then runs on with its D^-5 terms). A swimmer's own spheres touching always stops the run. CPU only.", "let s = scene(); s.overlaps = \"allow\"; print(s.overlaps);"),
     doc_entry!("steric", "numerics", "s.steric -> map or ()\ns.steric = #{ range, stiffness[, body, law] } | ()", "A soft repulsion between swimmers: force stiffness * (range - gap) (N) when their surface gap is below range (m). Off by default (). law: \"harmonic\" (default) as written; \"smooth\" stiffness * (range - gap)^2 / range, the same force at contact but starting with no kink, which adaptive steps cross far more cheaply (suspensions held in contact by the far field). body: \"spheres\" (default) repels spheres of different swimmers along their line of centres; \"rods\" treats each swimmer as a rod from sphere to sphere, thickened by the radii, so swimmers can neither touch nor pass through each other (the force acts at the rods' closest points, shared by the two spheres; those points jump from end to end as two rods in contact turn through parallel, a jump in the torque: adaptive steps stall on two rods held exactly parallel in contact). Microscopic model: the forces join the spring forces in the mobility. Averaged model: each swimmer moves as a free-draining rigid dumbbell of length ell under them. Not in the rigid-stroke model; CPU only; one pass per right-hand side through cell lists in large scenes.", "let s = scene(); s.steric = #{ range: 1e-7, stiffness: 1e-3, body: \"rods\" }; print(s.steric.body);"),
     doc_entry!("cutoff", "numerics", "s.cutoff -> float or ()\ns.cutoff = distance | ()", "Far-field cutoff of the averaged model (m): pairs further apart are left out. Off by default (). Each left-out pair's contribution is bounded by 9/64 v0 (28|A_R|(Lambda/ell) xi^3 + 84 c_J xi^4) with xi = ell/cutoff (README, Suspensions).", "let s = scene(); s.cutoff = 100e-6; print(s.cutoff);"),
-    doc_entry!("box", "numerics", "s.box -> array or ()\ns.box = [Lx, Ly, Lz] | ()", "A periodic box of these sides (m) centred on the origin (-L/2 to L/2), or () for open space (the default). Pairs are measured by their minimum images; the sphere models use the periodic RPY (or Oseen) mobility by Ewald summation (Beenakker 1986, or spectral Ewald for many spheres: s.ewald_method; to s.ewald_tol, no net flow); the averaged model sums pairs within a cutoff of at most L/2 (L/2 when s.cutoff is not set). Snapshots, trajectories and fields show positions wrapped into the box; displacements and drift observables follow the unwrapped motion. add_random fills the box (s.add_random(d, n, seed)). CPU only. Saved with the scene.", "let s = scene(); s.box = [200e-6, 200e-6, 200e-6]; s.add_random(dumbbell(), 20, 1); print(s.box);"),
-    doc_entry!("ewald_method", "numerics", "s.ewald_method -> string\ns.ewald_method = \"auto\" | \"beenakker\" | \"spectral\"", "How the box's mobility products are summed for the spring model, s.sphere_velocities and the Lanczos noise root: \"beenakker\" sums over images and waves (O(N^2) per product); \"spectral\" is spectral Ewald (Lindbo & Tornberg 2010, the wave part of Fiore et al.'s positively split Ewald): real-space pairs within a cutoff of at most L/2 through cell lists, the wave part on an FFT grid (O(N log N)); \"auto\" (default) takes Beenakker below 700 spheres and spectral from there (the measured crossover, swimlab bench ewald). Both keep s.ewald_tol. The rigid model's constraint solve and the dense noise root take blocks, which are always Beenakker's. Saved with the scene.", "let s = scene(); s.ewald_method = \"spectral\"; print(s.ewald_method);"),
+    doc_entry!("box", "numerics", "s.box -> array or ()\ns.box = [Lx, Ly, Lz] | ()", "A periodic box of these sides (m) centred on the origin (-L/2 to L/2), or () for open space (the default). Pairs are measured by their minimum images; the sphere models use the periodic RPY (or Oseen) mobility by Ewald summation (Beenakker 1986, or spectral Ewald for many spheres: s.ewald_method; to s.ewald_tol, no net flow); the averaged model sums pairs within a cutoff of at most L/2 (L/2 when s.cutoff is not set). Snapshots, trajectories and fields show positions wrapped into the box; displacements and drift observables follow the unwrapped motion. add_random fills the box (s.add_random(d, n, seed)). Sides, like swimmer centres, may reach 1e8 times the smallest sphere radius (75 m for the paper's swimmers; beyond, f64 no longer resolves the spheres); longer ones are refused. CPU only. Saved with the scene.", "let s = scene(); s.box = [200e-6, 200e-6, 200e-6]; s.add_random(dumbbell(), 20, 1); print(s.box);"),
+    doc_entry!("ewald_method", "numerics", "s.ewald_method -> string\ns.ewald_method = \"auto\" | \"beenakker\" | \"spectral\"", "How the box's mobility products are summed for the spring model, s.sphere_velocities and the Lanczos noise root: \"beenakker\" sums over images and waves (O(N^2) per product); \"spectral\" is spectral Ewald (Lindbo & Tornberg 2010, the wave part of Fiore et al.'s positively split Ewald): real-space pairs within a cutoff of at most L/2 through cell lists, the wave part on an FFT grid (O(N log N)); \"auto\" (default) takes Beenakker below 700 spheres and spectral from there (the measured crossover, swimlab bench ewald); \"spectral\" chosen for fewer than 175 spheres, where its grid makes every product far costlier, says so on stderr (a note) when a run starts. Both keep s.ewald_tol. The rigid model's constraint solve and the dense noise root take blocks, which are always Beenakker's. Saved with the scene.", "let s = scene(); s.ewald_method = \"spectral\"; print(s.ewald_method);"),
     doc_entry!("ewald_tol", "numerics", "s.ewald_tol -> float\ns.ewald_tol = tol", "Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility (default 1e-10; 1e-15 to 1e-2). Both the real-space and the reciprocal sums are cut where their terms fall below it; the splitting is chosen for speed and the result does not depend on it.", "let s = scene(); s.ewald_tol = 1e-12; print(s.ewald_tol);"),
     doc_entry!("coefficients", "numerics", "s.coefficients -> string\ns.coefficients = \"paper\" | \"leading_order\"", "Coefficients of the averaged model's I and J terms: as published, or the leading-order ones.", "let s = scene(); s.coefficients = \"leading_order\"; print(s.coefficients);"),
-    doc_entry!("integrator_info", "numerics", "s.integrator_info -> string", "What the integrator runs on this scene: for auto(tol) the method it chose and why, else the integrator and whether it is the model's default.", "let s = scene(); s.add(dumbbell()); s.integrator = auto(1e-3); print(s.integrator_info);"),
+    doc_entry!("integrator_info", "numerics", "s.integrator_info -> string", "What the integrator runs on this scene: for auto(tol) the method it chose and why, else the integrator and whether it is the model's default; and, when stroboscopic averaging fell back to direct integration in the last run (its macro steps failing at their shortest length), when, why and for how many periods. Such a run also says so on stderr (a note) as it falls back.", "let s = scene(); s.add(dumbbell()); s.integrator = auto(1e-3); print(s.integrator_info);"),
     doc_entry!("integrator", "numerics", "s.integrator -> Integrator\ns.integrator = euler(dt) | rk4(dt) | dopri5(rtol) | rosw(rtol) | stroboscopic(tol) | auto(tol) | \"default\"", "The time integrator. The default depends on the model and the scene's stiffness.", "let s = scene(); s.add(dumbbell()); print(s.integrator); s.integrator = rk4(5e-6); print(s.integrator);"),
     doc_entry!("temperature", "thermal", "s.temperature -> float\ns.temperature = kelvin", "Temperature (K) of the solvent; 0 (the default) turns thermal noise off and leaves every result as before. Above 0 the spring model's spheres take Brownian steps with covariance 2 kT M dt for the full mobility M (RPY is divergence-free, so no drift term), and the averaged model's swimmers diffuse as rigid dumbbells (s.diffusion(i)). Needs euler(dt) (Euler-Maruyama) or platen(dt) (weak order 2); the default becomes euler at 0.1/s.stiff_rate (spring model) or T/20 (averaged). Not in the rigid-stroke model; CPU only.", "let s = scene(); s.add(dumbbell()); s.temperature = 300; s.run_periods(0.1); print(s.integrator);"),
     doc_entry!("seed", "thermal", "s.seed -> int\ns.seed = n", "Seed of the thermal noise (default 0). The noise of step k is a function of the seed and k alone (Philox4x32-10), so runs are reproducible, independent of the thread count, and a run split in two or saved and loaded between draws the same noise.", "let s = scene(); s.seed = 7; print(s.seed);"),

@@ -1,26 +1,16 @@
 //! How the REPL shows a value: the same text `print` gives for swimlab's types, Rhai's debug form
 //! for the rest.
 
-use super::dumbbell_api::DumbbellSpec;
-use super::observable_api::RecorderHandle;
-use super::picture_api::Picture;
-use super::scene_api::SceneHandle;
-use crate::engine::{IntegratorSpec, Observable, Trigger};
 use rhai::{Array, Dynamic, Map};
-
-/// The text of the first of `types` that `v` holds, through its `Display` (the one the type's
-/// `to_string` uses).
-macro_rules! displayed {
-    ($v:expr; $($t:ty),+) => {
-        $(if let Some(x) = $v.read_lock::<$t>() {
-            return x.to_string();
-        })+
-    };
-}
 
 /// Text for a value printed by the REPL.
 pub fn show(v: &Dynamic) -> String {
-    displayed!(v; SceneHandle, DumbbellSpec, IntegratorSpec, Observable, Trigger, RecorderHandle, Picture);
+    if let Some(text) = super::types::swimlab_text(v) {
+        return text;
+    }
+    if let Some(f) = v.read_lock::<rhai::FnPtr>() {
+        return super::types::fn_text(&f);
+    }
     if let Some(a) = v.clone().try_cast::<Array>() {
         return format!("[{}]", a.iter().map(show).collect::<Vec<_>>().join(", "));
     }

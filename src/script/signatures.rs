@@ -21,6 +21,9 @@ pub struct Vocabulary {
 /// A Rust type name as a script user knows it.
 fn script_type(t: &str) -> String {
     let t = t.trim().trim_start_matches("&mut ").trim_start_matches('&');
+    if let Some(name) = super::types::script_name(t) {
+        return name.to_string();
+    }
     let last = t.rsplit("::").next().unwrap_or(t);
     match last {
         "i64" | "INT" => "int".into(),
@@ -39,11 +42,12 @@ fn script_type(t: &str) -> String {
     }
 }
 
-/// The vocabulary of [`super::engine()`].
+/// The vocabulary of [`super::engine()`] (what it registers besides the forms of
+/// `wrong_calls`, which are built from this).
 pub fn vocabulary() -> &'static Vocabulary {
     static V: OnceLock<Vocabulary> = OnceLock::new();
     V.get_or_init(|| {
-        let engine = super::engine();
+        let (engine, _) = super::engine_builder::vocabulary_engine();
         let mut v = Vocabulary::default();
         let json = engine.gen_fn_metadata_to_json(false).unwrap_or_default();
         let parsed: serde_json::Value = serde_json::from_str(&json).unwrap_or_default();

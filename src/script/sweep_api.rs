@@ -3,11 +3,18 @@
 //! Each call is independent (it should build its own scene); the calls run on rayon's threads,
 //! the results come back in the order of `params`, and the first failing call (in that order)
 //! is the error, naming its parameter. Ctrl-C stops every call between statements.
+//!
+//! A scene that every call reaches (captured by the closure, or given in more than one
+//! parameter) is shared by calls running at once: they may read it (properties, observe, copy,
+//! save) but not change it, which would race and make the results change from run to run; a
+//! change is an error naming the fix (build the scene in the call, or change a copy).
 
 use super::convert::{script_error, ScriptResult};
 use super::docs::{doc_entry, Doc};
+use super::observable_api::RecorderHandle;
+use super::scene_api::SceneHandle;
 use rayon::prelude::*;
-use rhai::{Array, Dynamic, Engine, EvalAltResult, FnPtr, NativeCallContext, INT};
+use rhai::{Array, Dynamic, Engine, EvalAltResult, FnPtr, Map, NativeCallContext, INT};
 
 /// Threads per core a sweep may ask for: more only adds switching (the calls compute, they do
 /// not wait).
@@ -24,6 +31,32 @@ fn sweep(
     f: FnPtr,
     threads: Option<usize>,
 ) -> ScriptResult<Array> {
+    // Scenes the calls share: the closure's captures, and any reached from two parameters.
+    let mut shared = Vec::new();
+    if params.len() > 1 {
+        for v in f.curry() {
+            scenes_in(v, &mut shared, 0);
+        }
+        let mut seen: Vec<SceneHandle> = Vec::new();
+        for p in &params {
+            let mut here = Vec::new();
+            scenes_in(p, &mut here, 0);
+            for h in here {
+                if seen.iter().any(|s| s.same(&h)) {
+                    shared.push(h);
+                } else {
+                    seen.push(h);
+                }
+            }
+        }
+    }
+    let mut unique: Vec<SceneHandle> = Vec::new();
+    for h in shared {
+        if !unique.iter().any(|u| u.same(&h)) {
+            unique.push(h);
+        }
+    }
+    let _shared = SceneHandle::share_in_sweep(unique);
     let store = ctx.store_data();
     let engine = ctx.engine();
     let call = |(k, p): (usize, &Dynamic)| -> Result<Dynamic, (usize, Box<EvalAltResult>)> {
@@ -48,12 +81,34 @@ fn sweep(
             r.map_err(|(k, e)| {
                 script_error(format!(
                     "sweep: the call for parameter {k} ({}) failed: {}",
-                    params[k],
-                    e.to_string().trim_end()
+                    super::types::quote(&params[k]),
+                    super::render::message_of(&e)
                 ))
             })
         })
         .collect()
+}
+
+/// Nesting deeper than this is not searched for scenes (values nest arrays, maps and closures).
+const MAX_DEPTH: usize = 32;
+
+/// The scenes `v` reaches: itself, a recorder's scene, and those in arrays, maps and the captures
+/// of closures.
+fn scenes_in(v: &Dynamic, out: &mut Vec<SceneHandle>, depth: usize) {
+    if depth > MAX_DEPTH {
+        return;
+    }
+    if let Some(h) = v.read_lock::<SceneHandle>() {
+        out.push(h.clone());
+    } else if let Some(r) = v.read_lock::<RecorderHandle>() {
+        out.push(r.scene.clone());
+    } else if let Some(a) = v.read_lock::<Array>() {
+        a.iter().for_each(|x| scenes_in(x, out, depth + 1));
+    } else if let Some(m) = v.read_lock::<Map>() {
+        m.values().for_each(|x| scenes_in(x, out, depth + 1));
+    } else if let Some(f) = v.read_lock::<FnPtr>() {
+        f.curry().iter().for_each(|x| scenes_in(x, out, depth + 1));
+    }
 }
 
 /// Register `sweep`.
@@ -91,5 +146,5 @@ pub fn register(engine: &mut Engine) {
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[
-    doc_entry!("sweep", "scene", "sweep(params: array, f) -> array\nsweep(params: array, f, threads: int) -> array", "Call f(p) for every p of params on all cores (or on `threads` threads) and return the results in the order of params. Each call should build its own scene; results may be numbers, strings, arrays or maps. The first failing call is the error, naming its parameter. For clusters, run one process per parameter instead: swimlab run script.rhai --set D=10 (README, Sweeps).", "let r = sweep([1, 2, 3], |p| p * p); print(r);"),
+    doc_entry!("sweep", "scene", "sweep(params: array, f) -> array\nsweep(params: array, f, threads: int) -> array", "Call f(p) for every p of params on all cores (or on `threads` threads) and return the results in the order of params. Each call should build its own scene; results may be numbers, strings, arrays or maps. A scene every call reaches (captured by f, or given in more than one parameter) is shared by calls that run at once: they may read it (properties, observe, copy, save) but not change it (run, settings, recorders), which would race and make the results change from run to run; such a change is an error: build the scene inside f, or change a copy (|p| { let t = s.copy(); t.run_periods(p); t.time }). The first failing call is the error, naming its parameter. For clusters, run one process per parameter instead: swimlab run script.rhai --set D=10 (README, Sweeps).", "let r = sweep([1, 2, 3], |p| p * p); print(r);"),
 ];

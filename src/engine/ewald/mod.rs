@@ -23,7 +23,7 @@
 //! The result does not depend on ξ beyond that tolerance (tests/periodic.rs).
 
 use super::choice::{self, Choice, Named};
-use super::error::{invalid, Result};
+use super::error::{invalid, unsupported, Result, Setting};
 use super::mobility::{self_mobility, Mobility};
 use super::periodic::{PeriodicBox, WavePhases};
 use nalgebra::{DMatrix, Matrix3, Vector3};
@@ -222,6 +222,7 @@ impl Ewald {
             let waves = kc.powi(3) * volume / (12.0 * PI * PI);
             (images, waves)
         };
+        let given_xi = xi.is_some();
         let xi = match xi {
             Some(x) if x.is_finite() && x > 0.0 => x,
             Some(x) => {
@@ -248,16 +249,39 @@ impl Ewald {
             }
         };
         let (images, waves) = counts(xi);
-        if images > 2e5 || waves > 2e6 {
-            return Err(invalid!(
-                "the Ewald sums would need {images:.0} images and {waves:.0} waves at splitting {xi:e} 1/m; choose a splitting nearer 1/L (about {:e} 1/m) or a looser tolerance",
-                PI.sqrt() / periodic.shortest()
-            ));
-        }
         let rc = p / xi;
         let kc = 2.0 * p * xi;
         let half_diag = 0.5 * (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
         let reach = rc + half_diag;
+        // Lattice shifts tested: every minimum image lies within half the diagonal, so the images
+        // within r_c of it need shifts up to their sum, along each side.
+        let tested: f64 = l
+            .iter()
+            .map(|side| 2.0 * (reach / side).ceil() + 1.0)
+            .product();
+        if images > 2e5 || waves > 2e6 || tested > 2e7 {
+            if given_xi {
+                return Err(invalid!(
+                    "the Ewald sums would need {images:.0} images, {waves:.0} waves and {tested:.0} lattice shifts at splitting {xi:e} 1/m; choose a splitting nearer 1/L (about {:e} 1/m) or a looser tolerance",
+                    PI.sqrt() / periodic.shortest()
+                ));
+            }
+            return Err(unsupported(
+                format!(
+                    "the Ewald sums of a box of sides {:e}, {:e}, {:e} m at tolerance {tol:e} would need {images:.0} images, {waves:.0} waves and {tested:.0} lattice shifts, beyond what they take (2e5, 2e6 and 2e7): the box is too elongated (its sides {:.0} times apart) for this tolerance; give it sides nearer each other (the averaged model takes minimum images, no Ewald sums)",
+                    l[0],
+                    l[1],
+                    l[2],
+                    l.iter().copied().fold(0.0, f64::max) / periodic.shortest()
+                ),
+                if tested > 2e7 {
+                    // Shifts follow the box's shape, not the tolerance.
+                    &[Setting::Model("averaged")][..]
+                } else {
+                    &[Setting::LooserEwaldTol, Setting::Model("averaged")][..]
+                },
+            ));
+        }
         let m = l.map(|side| (reach / side).ceil() as i32);
         let mut shifts = Vec::new();
         for i in -m[0]..=m[0] {

@@ -7,9 +7,31 @@
 //! emulation (lavapipe/llvmpipe), so a real GPU wins over a software one when both exist.
 //!
 //! Environment: `WGPU_BACKEND` (e.g. `vulkan`) limits the backends searched, as in wgpu;
-//! `SWIMLAB_NO_GPU=1` hides every adapter (to test the fallback).
+//! `SWIMLAB_NO_GPU=1` hides every adapter (to test the fallback); see also
+//! [`quiet_device_selection`].
 
 use std::sync::{Arc, Mutex, OnceLock};
+
+/// Keep Mesa's device-selection layer (an implicit Vulkan layer) out of this process when
+/// there is no session runtime folder (`XDG_RUNTIME_DIR` unset or not a folder: a server, a
+/// container, CI), unless the user configured the layer (`NODEVICE_SELECT`,
+/// `MESA_VK_DEVICE_SELECT`). The layer only orders the devices, which [`device`] ranks itself,
+/// and to learn the desktop's default device it connects to the Wayland display, whose library
+/// prints "XDG_RUNTIME_DIR is invalid or not set in the environment." on stderr for every
+/// instance made without that folder. Nothing else is silenced: drivers' own errors still show.
+///
+/// It sets an environment variable, so it must run before any other thread starts: first thing
+/// in `main`.
+pub fn quiet_device_selection() {
+    let configured = ["NODEVICE_SELECT", "MESA_VK_DEVICE_SELECT"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some());
+    let runtime_dir =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if !configured && !runtime_dir {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
+}
 
 /// Storage buffers each kernel binds (groups 0 and 1 of common.wgsl).
 const STORAGE_BUFFERS: u32 = 10;

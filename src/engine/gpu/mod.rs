@@ -22,7 +22,7 @@ pub mod micro_rates;
 pub mod rk_stages;
 pub mod runner;
 
-pub use device::{available, device, GpuDevice};
+pub use device::{available, device, quiet_device_selection, GpuDevice};
 pub use runner::{AdaptiveReport, AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
 
 use std::sync::{Arc, OnceLock};

@@ -27,13 +27,16 @@
 //!   at tol 1e-3, and a step's samples (6d periods) buy five times as many periods. The error
 //!   estimate is measured against the change the step makes (each 3-vector
 //!   against the largest change of its kind among all swimmers: positions, or orientations, whose
-//!   error turns the drift and so counts against the positions' change as well), not
-//!   against absolute positions: `tol` is relative to the drift. A per-period round-off allowance
+//!   error turns the drift and so counts against the positions' change as well; orientations
+//!   are measured across themselves, since along them lies a spring's length, a fast variable),
+//!   not against absolute positions: `tol` is relative to the drift. A per-period round-off allowance
 //!   keeps components that do not move from demanding the impossible.
 //! - **Direct runs.** The start transient (whenever the state is not the one this stepper left:
 //!   a fresh run, a changed phase, a loaded scene), a remainder of less than [`MIN_MACRO`] periods
 //!   and the fraction of a period before `t_end` are integrated by the inner (microscopic)
-//!   integrator itself, so a row between period multiples is a true microscopic state.
+//!   integrator itself, so a row between period multiples is a true microscopic state; so are
+//!   stretches where macro steps fail at their shortest, counted in [`Stats`] and told, with
+//!   why, by [`Stepper::report`].
 
 use super::dopri5::{A, E};
 use super::system::{check_state, Interrupt, OdeSystem, Problem, Stats, StepFailure, Stepper};
@@ -150,6 +153,19 @@ pub struct Stroboscopic {
     direct_periods: u64,
     /// Asked between inner steps: a macro step spans many periods.
     interrupt: Option<Interrupt>,
+    /// The latest fall-back to direct integration: its time, why, and the periods integrated
+    /// directly since the macro steps last succeeded.
+    fallback: Option<Fallback>,
+}
+
+/// Macro steps that failed at their shortest length, and the direct integration that followed.
+struct Fallback {
+    /// When (s).
+    time: f64,
+    /// Why, in words.
+    why: String,
+    /// Periods integrated directly since then, until a macro step is accepted again.
+    periods: u64,
 }
 
 impl Stroboscopic {
@@ -178,6 +194,7 @@ impl Stroboscopic {
             degree: 2,
             direct_periods: MIN_MACRO,
             interrupt: None,
+            fallback: None,
         }
     }
 
@@ -326,19 +343,44 @@ impl Stroboscopic {
     }
 
     /// Max over 3-vectors of |err| / (tol · largest change of that kind + round-off allowance).
+    ///
+    /// An orientation vector's part along itself is its length: in the spring model the spring's
+    /// length, a fast variable that the stages and the solution take from their rates on the slow
+    /// manifold ([`OdeSystem::set_fast_variables`]), never from the slopes; in the rigid-stroke
+    /// model the norm of a unit vector, which the projection restores. So errors and changes of
+    /// orientations are measured across them only. Along them, a stage's length set a little off
+    /// the manifold relaxes within the first sample period, and that jump, which says nothing
+    /// about the slow flow, would otherwise enter every slope of the orientation and, against a
+    /// small tolerance times a slow turn, fail every degree check and every macro step.
     fn error_norm(&self, y: &[f64], y_new: &[f64], err: &[f64], m: u64) -> f64 {
         let blocks = y.len() / 3;
-        let norm3 = |v: &[f64], b: usize| {
-            let s = &v[3 * b..3 * b + 3];
-            (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
+        let vec3 = |v: &[f64], b: usize| [v[3 * b], v[3 * b + 1], v[3 * b + 2]];
+        let norm = |s: [f64; 3]| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+        // Block b of v; an orientation block without its part along y's orientation.
+        let part = |v: &[f64], b: usize| {
+            let s = vec3(v, b);
+            if b.is_multiple_of(2) {
+                return s;
+            }
+            let o = vec3(y, b);
+            let o2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
+            if o2 == 0.0 {
+                return s;
+            }
+            let along = (s[0] * o[0] + s[1] * o[1] + s[2] * o[2]) / o2;
+            [
+                s[0] - along * o[0],
+                s[1] - along * o[1],
+                s[2] - along * o[2],
+            ]
         };
         let mut change = [0.0f64; 2];
         let mut size = [self.length, 0.0f64];
         let diff: Vec<f64> = y_new.iter().zip(y).map(|(a, b)| a - b).collect();
         for b in 0..blocks {
-            change[b % 2] = change[b % 2].max(norm3(&diff, b));
+            change[b % 2] = change[b % 2].max(norm(part(&diff, b)));
             if b % 2 == 1 {
-                size[1] = size[1].max(norm3(y, b));
+                size[1] = size[1].max(norm(vec3(y, b)));
             }
         }
         // An orientation error δ turns the drift by δ/|b|: it is measured against the larger of
@@ -346,7 +388,7 @@ impl Stroboscopic {
         let moved = [change[0], change[1].max(change[0] * size[1] / self.length)];
         let allowance = |c: usize| self.tol * moved[c] + m as f64 * NOISE_PER_PERIOD * size[c];
         (0..blocks)
-            .map(|b| norm3(err, b) / allowance(b % 2))
+            .map(|b| norm(part(err, b)) / allowance(b % 2))
             .fold(0.0, f64::max)
     }
 
@@ -476,18 +518,23 @@ impl Stepper for Stroboscopic {
                     self.slope = Some(k4);
                     self.direct_periods = MIN_MACRO;
                     stats.macro_steps += 1;
+                    self.fallback = None;
                     return Ok(self.leave(t_new, y));
                 }
                 outcome => {
                     self.stop_if_interrupted(t)?;
                     stats.rejected += 1;
-                    let shrink = match outcome {
-                        Some((_, _, e)) if e.is_finite() => {
-                            (0.9 * e.powf(-1.0 / ESTIMATE_ORDER)).clamp(0.2, 0.9)
-                        }
+                    let (shrink, why) = match outcome {
+                        Some((_, _, e)) if e.is_finite() => (
+                            (0.9 * e.powf(-1.0 / ESTIMATE_ORDER)).clamp(0.2, 0.9),
+                            format!("a macro step of {m} periods had an error estimate of {e:.3} times the tolerance"),
+                        ),
                         _ => {
                             stats.rejected_by_guard += 1;
-                            0.25
+                            (
+                                0.25,
+                                format!("a stage state of a macro step of {m} periods failed a guard (NaN, overlapping spheres or a runaway spring)"),
+                            )
                         }
                     };
                     rejects += 1;
@@ -501,6 +548,26 @@ impl Stepper for Stroboscopic {
                         let mut trial = y.to_vec();
                         self.psi(sys, t, &mut trial, k as u32, stats)?;
                         y.copy_from_slice(&trial);
+                        stats.direct_fallbacks += 1;
+                        stats.fallback_periods += k;
+                        let why = if m == MIN_MACRO {
+                            format!("{why}, the shortest a macro step may be")
+                        } else {
+                            format!("{rejects} macro steps in a row were rejected; the last: {why}")
+                        };
+                        match &mut self.fallback {
+                            Some(f) => {
+                                f.why = why;
+                                f.periods += k;
+                            }
+                            None => {
+                                self.fallback = Some(Fallback {
+                                    time: t,
+                                    why,
+                                    periods: k,
+                                })
+                            }
+                        }
                         return Ok(self.leave(snap(t + k as f64 * period), y));
                     }
                     self.h_periods = m as f64 * shrink;
@@ -511,6 +578,14 @@ impl Stepper for Stroboscopic {
 
     fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
         self.interrupt = interrupt;
+    }
+
+    fn report(&self) -> Option<String> {
+        let f = self.fallback.as_ref()?;
+        Some(format!(
+            "from t = {:.6e} s macro steps fail ({}): the motion is not slow enough for tol {:e} there, so the run integrates it directly with the inner method, {} periods so far, each as costly as a sample period; a looser tol lets macro steps through",
+            f.time, f.why, self.tol, f.periods
+        ))
     }
 
     fn reset(&mut self) {

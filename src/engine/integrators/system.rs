@@ -258,6 +258,13 @@ pub struct Stats {
     /// two, or saved and loaded between, draws the same noise (saved only when non-zero).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub noisy_steps: u64,
+    /// Times stroboscopic averaging's macro steps failed at their shortest length and it
+    /// integrated directly instead (saved only when non-zero).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub direct_fallbacks: u64,
+    /// Periods those fallbacks integrated directly (saved only when non-zero).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub fallback_periods: u64,
 }
 
 fn is_zero(n: &u64) -> bool {
@@ -304,6 +311,12 @@ pub trait Stepper: Send + Sync {
     /// Go on with `h` as the next step, after another backend took the steps before (the state
     /// changed outside: nothing cached about it is kept).
     fn continue_with_step(&mut self, _h: f64) {}
+
+    /// What this stepper did that its name does not say, in words (stroboscopic averaging that
+    /// fell back to direct integration, and why); `None` when there is nothing to add.
+    fn report(&self) -> Option<String> {
+        None
+    }
 }
 
 /// Size every scratch buffer of a stepper to the state's length (allocates only when it grows).

@@ -24,6 +24,18 @@ struct SavedScene<'a> {
 }
 
 impl Scene {
+    /// The latest time this scene may hold (s): [`MAX_TIME_IN_PERIODS`] of its longest stroke
+    /// period (of 1 s without swimmers). A load refuses a later time, and no run goes past it.
+    pub fn latest_time(&self) -> f64 {
+        let longest = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .reduce(f64::max)
+            .unwrap_or(1.0);
+        longest * MAX_TIME_IN_PERIODS
+    }
+
     /// The scene as JSON (swimmers, phases, model, integrator, time, state), exactly round-tripping.
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string_pretty(&SavedScene {
@@ -110,12 +122,7 @@ impl Scene {
                 self.time
             ));
         }
-        let t_max = self
-            .swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(1.0, f64::max)
-            * MAX_TIME_IN_PERIODS;
+        let t_max = self.latest_time();
         if self.time > t_max {
             return Err(invalid!(
                 "time is {:e} s, beyond {MAX_TIME_IN_PERIODS:e} stroke periods ({t_max:e} s), where f64 no longer resolves the stroke; reset the time to 0 (the state is what matters)",
@@ -132,6 +139,13 @@ impl Scene {
                 "state value {k} (swimmer {}) is not finite",
                 k / STATE_PER_SWIMMER
             ));
+        }
+        for i in 0..self.count() {
+            super::check_center(&self.center(i)?, &self.swimmers)
+                .map_err(|e| invalid!("swimmer {i}: {e}"))?;
+        }
+        if let Some(b) = &self.periodic {
+            super::check_box_extent(b, &self.swimmers)?;
         }
         for i in 0..self.count() {
             let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);

@@ -220,6 +220,11 @@ pub fn run(path: &Path) -> Result<(), String> {
     console::set_sink(Some(Arc::new(move |s: &str| {
         sh.publish_current("stream", json!({"name": "stdout", "text": s}));
     })));
+    // Notes a run gives (a cost far beyond its length, and why) go to the cell's stderr.
+    let sh = shared.clone();
+    console::set_note_sink(Some(Arc::new(move |s: &str| {
+        sh.publish_current("stream", json!({"name": "stderr", "text": s}));
+    })));
     let sh = shared.clone();
     // One display per run: shown at its first line, updated in place, cleared at its end.
     let open: Mutex<Option<String>> = Mutex::new(None);
@@ -260,6 +265,7 @@ pub fn run(path: &Path) -> Result<(), String> {
     progress::set_sink(None);
     console::set_sink(None);
     console::set_display_sink(None);
+    console::set_note_sink(None);
     let _ = publisher.join();
     Ok(())
 }

@@ -1,0 +1,424 @@
+//! A seeded fuzz of the newer script API (issue 38): boxes and Ewald sums, thermal noise, fields
+//! and the structure factor, stroboscopic averaging and `auto`, trajectories, pictures and
+//! animations, sweeps (shared scenes included), notes and the one-writer-per-file rule. A few
+//! hundred short scripts of random calls with random, often hostile, arguments, each starting
+//! from one of several scenes (open space, a box, the averaged model, noise). Every script must
+//! end by itself or stop promptly when interrupted (as Ctrl-C would); no panic may reach the
+//! script boundary, where it would show as an "internal error"; no message may show a Rust path
+//! or a Rust debug form. An abort (out of memory) ends this test process, which fails the test.
+//!
+//! The interrupt is process-wide, so this file holds one test and runs its scripts in turn. The
+//! older API has its own fuzz (`tests/fuzz_script_api.rs`).
+
+use std::sync::mpsc;
+use std::time::Duration;
+use swimlab::script::{interrupt, run_source};
+
+/// Scripts per run: every template is drawn ~60 times, and the run stays well under a minute
+/// (most statements of hostile arguments stop at their first check).
+const SCRIPTS: usize = 800;
+/// Statements per script.
+const STATEMENTS: usize = 7;
+/// A script still running after this is interrupted, as a user would press Ctrl-C...
+const PATIENCE: Duration = Duration::from_secs(3);
+/// ...and must then stop within this: a step of any scene here (six spheres at most, spectral
+/// Ewald included) takes well under a second.
+const STOP_WITHIN: Duration = Duration::from_secs(10);
+/// The seed of the scripts: the same scripts on every machine. `SWIMLAB_FUZZ_SEED` and
+/// `SWIMLAB_FUZZ_SCRIPTS` explore others (a failure names its script, which reruns alone).
+const SEED: u64 = 38_2026;
+
+fn from_env<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// SplitMix64.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn pick<'a>(&mut self, from: &[&'a str]) -> &'a str {
+        from[(self.next() % from.len() as u64) as usize]
+    }
+}
+
+/// Argument values `V`: ordinary, extreme, of the wrong type, and the newer types.
+const VALUES: &[&str] = &[
+    "0",
+    "1",
+    "2",
+    "-1",
+    "0.5",
+    "0.01",
+    "1e-300",
+    "1e300",
+    "1e308",
+    "5e-324",
+    "1e-9",
+    "1e-12",
+    "9223372036854775807",
+    "-9223372036854775807",
+    "(0.0/0.0)",
+    "(1.0/0.0)",
+    "\"\"",
+    "\"x\"",
+    "\"density\"",
+    "\"polarization\"",
+    "\"nematic\"",
+    "\"spectral\"",
+    "\"beenakker\"",
+    "\"auto\"",
+    "\"lanczos\"",
+    "\"cholesky\"",
+    "\"mean\"",
+    "\"max\"",
+    "\"2\"",
+    "[]",
+    "[1, 2, 3]",
+    "[120e-6, 120e-6, 120e-6]",
+    "[1e308, 1e-4, 1e-4]",
+    "[1e-4, 1e-4, 1e-2]",
+    "[70, 1e-4, 1e-4]",
+    "[1e200, 1e200, 1e-4]",
+    "[[1e308, 0, 0]]",
+    "[[0, 40e-6, 0], [0, -40e-6, 0]]",
+    "[4, 4, 4]",
+    "[100000, 100000, 100000]",
+    "[0, 1, 1]",
+    "#{}",
+    "#{ grid: [8, 8, 8] }",
+    "#{ grid: [8, 8, 8], width: 1e-5 }",
+    "#{ width: -1 }",
+    "#{ bins: 4 }",
+    "#{ bins: 0, k_max: 1e308 }",
+    "#{ axis: \"z\", index: 2 }",
+    "#{ frames: 2, periods: 0.05 }",
+    "#{ frames: 1000000 }",
+    "#{ plane: \"xz\", title: \"t\" }",
+    "()",
+    "true",
+    "s",
+    "b",
+    "r",
+    "f",
+    "d",
+    "R_H(0)",
+    "every_periods(0.5)",
+    "every_seconds(1e-9)",
+    "at_end()",
+    "euler(1e-6)",
+    "stroboscopic(1e-3)",
+    "stroboscopic(1e-8)",
+    "stroboscopic(1e-2, rk4(1e-5))",
+    "auto(1e-3)",
+    "auto(1e-8)",
+    "platen(1e-6)",
+    "dopri5(1e-6)",
+    "|p| p",
+    "#{ x: [1, 2], y: [3, 4] }",
+    "plot(#{ x: [1, 2], y: [3, 4] })",
+];
+
+/// Paths `P`: a scratch folder (the same few names, so writers meet), and paths that cannot be
+/// written (never a device to write).
+fn paths(dir: &str) -> Vec<String> {
+    [
+        "t.xyz",
+        "t.pvd",
+        "u.xyz",
+        "a.csv",
+        "a.png",
+        "a.svg",
+        "a.gif",
+        "a.vti",
+        "s.json",
+        "sub/dir/b.pvd",
+        "sub/dir/b.gif",
+    ]
+    .iter()
+    .map(|n| format!("\"{dir}/{n}\""))
+    .chain([
+        format!("\"{dir}\""),
+        "\"/proc/x.png\"".into(),
+        "\"/proc/nope/x.gif\"".into(),
+        "\"/proc/x.xyz\"".into(),
+        "\"\"".into(),
+    ])
+    .collect()
+}
+
+/// Call templates: `V` is a value, `P` a path. `s` and `b` are scenes (`b` in a box), `r` a
+/// recorder of `s`, `f` a field of `s`, `d` a dumbbell.
+const CALLS: &[&str] = &[
+    // Boxes and Ewald sums.
+    "s.box = V",
+    "b.box = V",
+    "b.ewald_method = V",
+    "b.ewald_tol = V",
+    "b.add_at(d, V)",
+    "s.add_at(d, V)",
+    "b.add_at(d, lattice::fill(b.box, V, V, V))",
+    "b.add_at(d, lattice::fill(V, 2, 1, 1))",
+    "s.add_at(d, lattice::cubic(V, V, 2, 20e-6))",
+    "s.phases = phases::alternating(s.count, V)",
+    "b.add_random(d, V, 0.01, V)",
+    "b.sphere_velocities(V)",
+    "b.run_periods(V)",
+    "b.run(V)",
+    "b.cutoff = V",
+    "b.model = V",
+    // Thermal noise.
+    "s.temperature = V",
+    "b.temperature = V",
+    "s.seed = V",
+    "s.noise_root = V",
+    "s.lanczos_tol = V",
+    "s.integrator = platen(V)",
+    "s.integrator = euler(V)",
+    "s.diffusion(V)",
+    "s.observe(msd())",
+    "s.observe(peclet(V, V))",
+    // Fields and the structure factor.
+    "s.field(V)",
+    "s.field(V, V)",
+    "b.field(V, V)",
+    "f.stat(V)",
+    "f.plot(V)",
+    "f.plot(P)",
+    "f.plot(P, V)",
+    "f.to_vtk(P)",
+    "f.integral()",
+    "f.values.len()",
+    "display(f)",
+    "b.structure_factor(V)",
+    "b.structure_factor()",
+    "s.structure_factor()",
+    "b.observe(field_stat(V, V))",
+    "b.observe(field_stat(\"density\", \"max\", V))",
+    "s.record([field_stat(\"density\", V)], V)",
+    // Stroboscopic averaging and auto.
+    "s.integrator = V",
+    "b.integrator = V",
+    "s.integrator = stroboscopic(V)",
+    "s.integrator = stroboscopic(V, V)",
+    "s.integrator = auto(V)",
+    "s.integrator_info",
+    "b.integrator_info",
+    "s.stats",
+    "s.run_periods(V)",
+    "s.run(V)",
+    // Trajectories and recorders.
+    "s.trajectory(P, V)",
+    "b.trajectory(P, V)",
+    "s.trajectory(P, every_seconds(V))",
+    "s.copy().trajectory(P, 0.5)",
+    "r.stream_csv(P)",
+    "r.to_csv(P)",
+    "write_csv(P, [#{ a: V }])",
+    "s.save(P)",
+    "s = load_scene(P)",
+    "load_scene(P).run_periods(V)",
+    // Pictures and animations.
+    "plot(V)",
+    "plot(P, V)",
+    "plot(V).save(P)",
+    "s.snapshot()",
+    "s.snapshot(P)",
+    "s.snapshot(P, V)",
+    "b.snapshot(V)",
+    "s.animate(P)",
+    "s.animate(P, V)",
+    "b.animate(P, #{ frames: 2, periods: V })",
+    "display(V)",
+    "tplot(V)",
+    "r.plot(P, \"time\", V)",
+    "r.plot(\"time\", V)",
+    // Sweeps.
+    "sweep(V, |p| p)",
+    "sweep([1, 2, 3], |p| { s.run_periods(0.01); s.time }, 2)",
+    "sweep([1, 2], |p| { let t = s.copy(); t.run_periods(V); t.time })",
+    "sweep([s, s], |x| { x.mu = V; })",
+    "sweep([s, b], |x| { x.run_periods(0.01); x.time })",
+    "sweep([1, 2], |p| { r.stream_csv(P); })",
+    "sweep([1, 2], |p| { s.observe(V) })",
+    "sweep([1, 2], |p| { s.trajectory(P, 1) })",
+    "sweep(V, V, V)",
+    "sweep([1, 2], |a, b| a)",
+    "sweep([1, 2], V)",
+    // Smaller items.
+    "param(V, V)",
+    "lattice::cubic(V, 2, 1, V)",
+    "lattice::hexagonal(V, V, 1e-5)",
+    "1.0 / V",
+    "V + s",
+];
+
+/// The scenes a script starts from.
+const PROLOGUES: &[&str] = &[
+    // A pair in open space.
+    "let s = scene();\ns.add(dumbbell(#{ center: [-25e-6, 0, 0] }));\ns.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 }));\n",
+    // The Fig-1 mirror pair.
+    "let s = paper::mirror(10.0, true, true);\n",
+    // A pair under thermal noise.
+    "let s = scene();\ns.add(dumbbell(#{ center: [-25e-6, 0, 0] }));\ns.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 }));\ns.temperature = 300;\n",
+    // The averaged model.
+    "let s = scene();\ns.model = \"averaged\";\ns.add(dumbbell(#{ center: [-25e-6, 0, 0] }));\ns.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 }));\n",
+];
+
+/// Every script has a box scene `b`, a recorder `r` and a field `f` besides its `s`.
+const COMMON: &str = "let b = scene();\nb.box = [120e-6, 120e-6, 120e-6];\nb.add(dumbbell(#{ center: [-30e-6, 0, 0] }));\nb.add(dumbbell(#{ phase: 1.0 }));\nlet d = dumbbell();\nlet r = s.record([R_H(0)], 1);\nlet f = s.field(\"density\", #{ grid: [8, 8, 8] });\n";
+
+fn script(rng: &mut Rng, paths: &[String]) -> String {
+    let p: Vec<&str> = paths.iter().map(String::as_str).collect();
+    let mut src = String::from(
+        "import \"paper\" as paper;\nimport \"lattice\" as lattice;\nimport \"phases\" as phases;\n",
+    );
+    src.push_str(rng.pick(PROLOGUES));
+    src.push_str(COMMON);
+    for _ in 0..STATEMENTS {
+        let mut call = rng.pick(CALLS).to_string();
+        // Fill the placeholders left to right; values and paths hold no placeholder letters of
+        // their own that a later search could take (they are looked for in the template only).
+        let mut out = String::new();
+        for c in call.drain(..) {
+            match c {
+                'V' => out.push_str(rng.pick(VALUES)),
+                'P' => out.push_str(rng.pick(&p)),
+                c => out.push(c),
+            }
+        }
+        src.push_str(&format!("try {{ {out}; }} catch (e) {{ print(e); }}\n"));
+    }
+    src
+}
+
+/// What no message may show: a Rust path or debug form, or Rhai's generated closure names.
+const LEAKS: &[&str] = &[
+    "swimlab::",
+    "Os {",
+    "IoError",
+    "ImageError",
+    "anon$",
+    "alloc::",
+];
+
+/// A printed line that quotes Rust's spelling of a string type. A swimlab function's wrong call
+/// reaches `catch` as its message; an operator's is still Rhai's own error map (Rhai's builtin
+/// operators come after any registered form, so none is registered for them), which may.
+fn rust_spelling(line: &str) -> bool {
+    let operator_map = line
+        .strip_prefix("#{\"error\": \"ErrorFunctionNotFound\", \"function\": \"")
+        .and_then(|rest| rest.split(' ').next())
+        .is_some_and(|f| !f.chars().any(|c| c.is_alphanumeric() || c == '_'));
+    line.contains("ImmutableString") && !operator_map
+}
+
+#[test]
+fn newer_api_scripts_neither_panic_nor_hang_nor_leak_rust_names() {
+    let dir = std::env::temp_dir().join(format!("swimlab-fuzz-newer-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::env::set_var("SWIMLAB_PROGRESS", "0");
+    let paths = paths(&dir.display().to_string());
+    let (seed, scripts) = (
+        from_env("SWIMLAB_FUZZ_SEED", SEED),
+        from_env("SWIMLAB_FUZZ_SCRIPTS", SCRIPTS),
+    );
+    let mut rng = Rng(seed);
+    let mut interrupted = 0;
+    for k in 0..scripts {
+        let src = script(&mut rng, &paths);
+        let (tx, rx) = mpsc::channel();
+        let body = src.clone();
+        std::thread::spawn(move || {
+            // print(e) inside the script goes to this process's stdout; the messages are
+            // checked through a capture of what `print` gets.
+            let printed = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
+            let sink = printed.clone();
+            let mut engine = swimlab::script::engine();
+            engine.on_print(move |s| {
+                if let Ok(mut p) = sink.lock() {
+                    p.push_str(s);
+                    p.push('\n');
+                }
+            });
+            let mut scope = rhai::Scope::new();
+            let result = engine
+                .compile(&body)
+                .map_err(|e| e.to_string())
+                .and_then(|ast| {
+                    engine
+                        .run_ast_with_scope(&mut scope, &ast)
+                        .map_err(|e| e.to_string())
+                });
+            let text = printed.lock().map(|p| p.clone()).unwrap_or_default();
+            // Once in a while the whole script again, through the renderer's path.
+            let rendered = (k % 16 == 0).then(|| {
+                let mut scope = rhai::Scope::new();
+                run_source("fuzz.rhai", &body, &mut scope).err()
+            });
+            let _ = tx.send((result, text, rendered.flatten()));
+        });
+        let (result, printed, rendered) = match rx.recv_timeout(PATIENCE) {
+            Ok(r) => r,
+            Err(_) => {
+                interrupted += 1;
+                // Asked again and again, as a user presses Ctrl-C until it stops: the second,
+                // rendered run clears the request when it starts.
+                let asked = std::time::Instant::now();
+                let r = loop {
+                    interrupt::request();
+                    if let Ok(r) = rx.recv_timeout(Duration::from_millis(100)) {
+                        break r;
+                    }
+                    assert!(
+                        asked.elapsed() < STOP_WITHIN,
+                        "script {k} did not stop within {STOP_WITHIN:?} of an interrupt:\n{src}"
+                    );
+                };
+                interrupt::clear();
+                let calls: Vec<&str> = src.lines().filter(|l| l.starts_with("try")).collect();
+                eprintln!(
+                    "script {k} interrupted after {PATIENCE:?}:\n  {}",
+                    calls.join("\n  ")
+                );
+                r
+            }
+        };
+        let all = format!(
+            "{}\n{printed}",
+            result.as_ref().err().cloned().unwrap_or_default()
+        );
+        assert!(
+            !all.contains("internal error"),
+            "script {k} panicked:\n{src}\n---\n{all}"
+        );
+        for leak in LEAKS {
+            assert!(
+                !printed.contains(leak),
+                "script {k} shows {leak:?}:\n{src}\n---\n{printed}"
+            );
+        }
+        if let Some(line) = printed.lines().find(|l| rust_spelling(l)) {
+            panic!("script {k} shows a Rust type:\n{src}\n---\n{line}");
+        }
+        if let Some(msg) = rendered {
+            assert!(
+                !msg.contains("internal error"),
+                "script {k}:\n{src}\n---\n{msg}"
+            );
+            for leak in LEAKS {
+                assert!(!msg.contains(leak), "script {k} shows {leak:?}:\n{msg}");
+            }
+        }
+    }
+    eprintln!("{scripts} scripts (seed {seed}), {interrupted} interrupted after {PATIENCE:?}");
+}
