@@ -14,6 +14,10 @@ use super::{vec3, AveragedSystem, STATE_PER_SWIMMER};
 use crate::engine::integrators::GroupJacobian;
 use crate::engine::periodic::separation;
 use nalgebra::Vector3;
+use rayon::prelude::*;
+
+/// Contact clusters from this many on have their Jacobian blocks found on rayon's threads.
+const PARALLEL_CLUSTERS: usize = 16;
 
 /// Bodies within this many repulsion ranges of touching count as in contact for the Jacobian.
 pub const CONTACT_MARGIN_OF_RANGE: f64 = 2.0;
@@ -159,15 +163,19 @@ impl AveragedSystem {
 
     /// The clusters joined by `contacts` and their Jacobian blocks at `y`.
     pub(super) fn jacobian_of(&self, y: &[f64], contacts: &[Contact]) -> GroupJacobian {
-        let clusters = clusters_of(self.coef.len(), contacts);
+        let (clusters, of_contact) = clusters_of(contacts);
+        let mut by_cluster: Vec<Vec<Contact>> = vec![Vec::new(); clusters.len()];
+        for (c, &k) in contacts.iter().zip(&of_contact) {
+            by_cluster[k].push(*c);
+        }
         let ell = self.coef.iter().map(|c| c.ell).fold(0.0, f64::max);
-        let mut jac = GroupJacobian::default();
-        for cluster in clusters {
+        let blocks_of = |(cluster, contacts): (&Vec<usize>, &Vec<Contact>)| {
             let groups: Vec<Vec<usize>> = if cluster.len() > MAX_CLUSTER_SWIMMERS {
                 cluster.iter().map(|&s| vec![s]).collect()
             } else {
-                vec![cluster]
+                vec![cluster.clone()]
             };
+            let mut out = Vec::with_capacity(groups.len());
             for group in groups {
                 let inside: Vec<Contact> = contacts
                     .iter()
@@ -196,10 +204,23 @@ impl AveragedSystem {
                     .iter()
                     .flat_map(|&s| (0..6).map(move |c| STATE_PER_SWIMMER * s + c))
                     .collect();
-                jac.groups.push((idx, block));
+                out.push((idx, block));
             }
+            out
+        };
+        // Clusters are independent: in parallel when there are many, in their order either way.
+        let blocks: Vec<Vec<(Vec<usize>, Vec<f64>)>> = if clusters.len() >= PARALLEL_CLUSTERS {
+            clusters
+                .par_iter()
+                .zip(&by_cluster)
+                .map(blocks_of)
+                .collect()
+        } else {
+            clusters.iter().zip(&by_cluster).map(blocks_of).collect()
+        };
+        GroupJacobian {
+            groups: blocks.into_iter().flatten().collect(),
         }
-        jac
     }
 
     /// The errors of a step from `y` to `y_new` (embedded estimate `err`, step `h`, rates `f0` at
@@ -261,9 +282,15 @@ impl AveragedSystem {
 }
 
 /// The connected sets of swimmers joined by `contacts`, each sorted, in order of their smallest
-/// swimmer (swimmers in no contact are in none).
-fn clusters_of(n: usize, contacts: &[Contact]) -> Vec<Vec<usize>> {
-    let mut parent: Vec<usize> = (0..n).collect();
+/// swimmer (swimmers in no contact are in none), and for each contact the index of its set.
+/// Work and memory follow the contacts, not the swimmer count (a refinement asks for the
+/// clusters of a few swimmers many times a step).
+fn clusters_of(contacts: &[Contact]) -> (Vec<Vec<usize>>, Vec<usize>) {
+    let mut touched: Vec<usize> = contacts.iter().flat_map(|c| [c.0, c.1]).collect();
+    touched.sort_unstable();
+    touched.dedup();
+    let index = |s: usize| touched.binary_search(&s).unwrap_or(0);
+    let mut parent: Vec<usize> = (0..touched.len()).collect();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
         while parent[i] != i {
             parent[i] = parent[parent[i]];
@@ -272,18 +299,25 @@ fn clusters_of(n: usize, contacts: &[Contact]) -> Vec<Vec<usize>> {
         i
     }
     for &(s, r, _) in contacts {
-        let (a, b) = (root(&mut parent, s), root(&mut parent, r));
+        let (a, b) = (root(&mut parent, index(s)), root(&mut parent, index(r)));
         if a != b {
             parent[a.max(b)] = a.min(b);
         }
     }
-    let mut members: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
-    let mut touched: Vec<usize> = contacts.iter().flat_map(|c| [c.0, c.1]).collect();
-    touched.sort_unstable();
-    touched.dedup();
-    for s in touched {
-        let r = root(&mut parent, s);
-        members.entry(r).or_default().push(s);
+    // Roots are the smallest index of their set, so sets come in order of their smallest swimmer.
+    let mut set_of_root = vec![usize::MAX; touched.len()];
+    let mut sets: Vec<Vec<usize>> = Vec::new();
+    for (i, &s) in touched.iter().enumerate() {
+        let r = root(&mut parent, i);
+        if set_of_root[r] == usize::MAX {
+            set_of_root[r] = sets.len();
+            sets.push(Vec::new());
+        }
+        sets[set_of_root[r]].push(s);
     }
-    members.into_values().collect()
+    let of_contact = contacts
+        .iter()
+        .map(|c| set_of_root[root(&mut parent, index(c.0))])
+        .collect();
+    (sets, of_contact)
 }

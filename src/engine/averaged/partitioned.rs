@@ -122,16 +122,28 @@ impl Partitioned for AveragedSystem {
         }
     }
 
-    fn stiff_groups_of(&mut self, _t: f64, y: &[f64], bodies: &[usize]) -> Option<GroupJacobian> {
+    fn stiff_groups_of(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        bodies: &[usize],
+    ) -> Result<GroupJacobian, Vec<usize>> {
         if self.contacts.steric.is_none() {
-            return Some(GroupJacobian::default());
+            return Ok(GroupJacobian::default());
         }
         let contacts = self.contacts_among(y, Some(bodies));
         let inside = |s: usize| bodies.binary_search(&s).is_ok();
-        if contacts.iter().any(|c| !(inside(c.0) && inside(c.1))) {
-            return None;
+        let mut crossing: Vec<usize> = contacts
+            .iter()
+            .filter(|c| !(inside(c.0) && inside(c.1)))
+            .flat_map(|c| [c.0, c.1])
+            .collect();
+        if !crossing.is_empty() {
+            crossing.sort_unstable();
+            crossing.dedup();
+            return Err(crossing);
         }
-        Some(self.jacobian_of(y, &contacts))
+        Ok(self.jacobian_of(y, &contacts))
     }
 }
 

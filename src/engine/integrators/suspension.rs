@@ -254,11 +254,19 @@ impl Suspension {
             self.prepare_sub(y, n);
             self.paths.clear();
             steps = 0;
+            // A contact forming between a group and a swimmer outside it: both join the refined
+            // swimmers and the round is taken again.
+            let mut grown = Vec::new();
             for group in groups_of(p, &refined) {
-                let Some(taken) = self.refine(p, t, h, y, &group, &floor) else {
-                    return (f64::INFINITY, false);
-                };
-                steps += taken;
+                match self.refine(p, t, h, y, &group, &floor) {
+                    Ok(taken) => steps += taken,
+                    Err(more) if !more.is_empty() => grown.extend(more),
+                    Err(_) => return (f64::INFINITY, false),
+                }
+            }
+            if !grown.is_empty() {
+                refined = closure(refined.into_iter().chain(grown).collect(), jac, bs);
+                continue;
             }
             let missed = self.redo_ring(p, t, h, y, &refined, &ring, &floor);
             if missed.is_empty() {
@@ -283,8 +291,8 @@ impl Suspension {
 
     /// One W-method step of `bodies` from `t0` by `h` from their states in `sub.y0`, the other
     /// states they read set by `read(yw, time)`: fills `sub.y1`, `sub.err`, `sub.f0` for their
-    /// components and returns the RMS of their errors, or `None` when a contact forms with a
-    /// swimmer outside.
+    /// components and returns the RMS of their errors, or the swimmers of contacts forming
+    /// across the edge of `bodies` (both ends).
     #[allow(clippy::too_many_arguments)]
     fn subset_step(
         sub: &mut Refinement,
@@ -296,7 +304,7 @@ impl Suspension {
         changed: &[usize],
         floor: &[f64],
         read: &dyn Fn(&mut [f64], f64),
-    ) -> Option<f64> {
+    ) -> Result<f64, Vec<usize>> {
         let bs = p.body_size();
         let comps = || bodies.iter().flat_map(move |&b| b * bs..(b + 1) * bs);
         for m in comps() {
@@ -356,7 +364,7 @@ impl Suspension {
             &mut sub.errors,
         );
         let sum: f64 = bodies.iter().map(|&b| sub.errors[b] * sub.errors[b]).sum();
-        Some((sum / bodies.len().max(1) as f64).sqrt())
+        Ok((sum / bodies.len().max(1) as f64).sqrt())
     }
 
     /// Scratch sized to the state `y`, with the working states at `y`.
@@ -414,7 +422,7 @@ impl Suspension {
         y: &[f64],
         bodies: &[usize],
         floor: &[f64],
-    ) -> Option<u64> {
+    ) -> Result<u64, Vec<usize>> {
         let bs = p.body_size();
         let mut partners = Vec::new();
         p.partners(bodies, &mut partners);
@@ -439,7 +447,7 @@ impl Suspension {
         while tau < h {
             attempts += 1;
             if attempts > MAX_SUBSTEPS {
-                return None;
+                return Err(Vec::new());
             }
             let span = h - tau;
             let (h_try, last) = if hs >= span {
@@ -473,7 +481,7 @@ impl Suspension {
             } else {
                 hs = h_try * fac.min(0.9);
                 if step_too_small(hs, t + tau) || hs < 1e-12 * h {
-                    return None;
+                    return Err(Vec::new());
                 }
             }
         }
@@ -481,7 +489,7 @@ impl Suspension {
             self.y_new[m] = self.sub.y0[m];
         }
         self.paths.push((comps, path));
-        Some(steps)
+        Ok(steps)
     }
 
     /// Take the coarse step again for the swimmers `ring` that read the refined ones, now reading
@@ -534,9 +542,14 @@ impl Suspension {
                 }
             }
         };
-        if Self::subset_step(&mut self.sub, p, self.tol, t, h, ring, &changed, floor, &at).is_none()
+        if let Err(crossing) =
+            Self::subset_step(&mut self.sub, p, self.tol, t, h, ring, &changed, floor, &at)
         {
-            return ring.to_vec();
+            // The ring swimmers and outsiders of contacts forming across the ring's edge.
+            return crossing
+                .into_iter()
+                .filter(|b| refined.binary_search(b).is_err())
+                .collect();
         }
         let missed: Vec<usize> = ring
             .iter()

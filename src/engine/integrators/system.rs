@@ -136,9 +136,15 @@ pub trait Partitioned {
         changed: &[usize],
         dy: &mut [f64],
     );
-    /// The stiff groups among `bodies` at `y`, or `None` when one of them would couple a body of
-    /// `bodies` to one outside (a contact forming with a body stepped apart).
-    fn stiff_groups_of(&mut self, t: f64, y: &[f64], bodies: &[usize]) -> Option<GroupJacobian>;
+    /// The stiff groups among `bodies` at `y`, or, when one of them would couple a body of
+    /// `bodies` to one outside (a contact forming with a body stepped apart), the bodies of every
+    /// such coupling, both ends, sorted.
+    fn stiff_groups_of(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        bodies: &[usize],
+    ) -> Result<GroupJacobian, Vec<usize>>;
 }
 
 /// A block-sparse matrix: a dense square block on each of several disjoint groups of state
