@@ -355,7 +355,7 @@ impl Steric {
     #[inline]
     fn rod_pair_force_within(&self, a: Rod, b: Rod, extra: f64) -> Option<(f64, Vector3<f64>)> {
         let ((p, d1, ra), (q, d2, rb)) = (a, b);
-        let (s, t) = closest_on_segments(&p, &d1, &q, &d2);
+        let (s, t) = contact_points(&p, &d1, &q, &d2);
         let r = (p + d1 * s) - (q + d2 * t);
         let reach = self.range + (1.0 - s) * ra[0] + s * ra[1] + (1.0 - t) * rb[0] + t * rb[1];
         let limit = reach + extra;
@@ -486,6 +486,42 @@ impl Steric {
     }
 }
 
+/// sin²θ below which two rods at angle θ act at points blended towards their overlap's middle
+/// (see [`contact_points`]): θ ≈ 5.7°.
+const PARALLEL_BLEND_SIN2: f64 = 0.01;
+
+/// Where the repulsion between segments p + s d1 and q + t d2 acts: their closest points, except
+/// near parallel. There the closest points jump from one end to the other as the segments turn
+/// through parallel (at parallel they are not unique), and with them the torque; so within
+/// [`PARALLEL_BLEND_SIN2`] each point is drawn towards the middle of the part of its segment that
+/// faces the other, fully at parallel, by a weight χ(sin²θ) = 3u² − 2u³ (u = sin²θ /
+/// [`PARALLEL_BLEND_SIN2`]) whose derivative vanishes at both ends. The points are the same
+/// seen from either segment, so the pair forces stay equal and opposite along one line.
+fn contact_points(
+    p: &Vector3<f64>,
+    d1: &Vector3<f64>,
+    q: &Vector3<f64>,
+    d2: &Vector3<f64>,
+) -> (f64, f64) {
+    let (s, t) = closest_on_segments(p, d1, q, d2);
+    let (a, e) = (d1.dot(d1), d2.dot(d2));
+    if a <= 0.0 || e <= 0.0 {
+        return (s, t);
+    }
+    let b = d1.dot(d2);
+    let u = ((a * e - b * b) / (a * e)).max(0.0) / PARALLEL_BLEND_SIN2;
+    if u >= 1.0 {
+        return (s, t);
+    }
+    let chi = u * u * (3.0 - 2.0 * u);
+    let r = p - q;
+    let (c, f) = (d1.dot(&r), d2.dot(&r));
+    // The other segment's ends projected onto each, clamped: the facing parts' middles.
+    let mid_s = 0.5 * ((-c / a).clamp(0.0, 1.0) + ((b - c) / a).clamp(0.0, 1.0));
+    let mid_t = 0.5 * ((f / e).clamp(0.0, 1.0) + ((b + f) / e).clamp(0.0, 1.0));
+    (mid_s + chi * (s - mid_s), mid_t + chi * (t - mid_t))
+}
+
 /// The fractions (s, t) ∈ [0, 1]² of the closest points of segments p + s·d1 and q + t·d2
 /// (Ericson, Real-Time Collision Detection, 5.1.9; parallel segments take s = 0 or the clamp).
 fn closest_on_segments(
@@ -569,6 +605,42 @@ mod tests {
         let pushed = all.iter().filter(|f| f.norm() > 0.0).count();
         assert!(pushed > 50, "only {pushed} spheres within reach");
         assert_eq!(by_cells, all);
+    }
+
+    /// Two rods in contact turned through parallel: the points where their repulsion acts move
+    /// continuously (closest points jump from one end to the other at parallel), the same points
+    /// seen from either rod, and away from parallel they are the closest points. Steps of 1e-5
+    /// rad move a point by ~1e-5 × (the blend's slope, below 1e3): a jump would be ~1.
+    #[test]
+    fn contact_points_move_continuously_through_parallel() {
+        let p = Vector3::new(0.0, 0.0, 0.0);
+        let d1 = Vector3::new(10.0, 0.0, 0.0);
+        let mut last: Option<(f64, f64)> = None;
+        for k in -2000..=2000 {
+            let th = k as f64 * 1e-5;
+            let q = Vector3::new(1.0, 0.3, 0.0);
+            let d2 = Vector3::new(10.0 * th.cos(), 10.0 * th.sin(), 0.0);
+            let (s, t) = contact_points(&p, &d1, &q, &d2);
+            let (t2, s2) = contact_points(&q, &d2, &p, &d1);
+            assert!(
+                (s - s2).abs() < 1e-12 && (t - t2).abs() < 1e-12,
+                "not symmetric at {th}"
+            );
+            if let Some((s0, t0)) = last {
+                assert!(
+                    (s - s0).abs() < 1e-2 && (t - t0).abs() < 1e-2,
+                    "jump at {th}: s {s0} -> {s}, t {t0} -> {t}"
+                );
+            }
+            last = Some((s, t));
+        }
+        // At 45 degrees: the closest points.
+        let d2 = Vector3::new(10.0 * 0.5f64.sqrt(), 10.0 * 0.5f64.sqrt(), 0.0);
+        let q = Vector3::new(1.0, 0.3, 1.0);
+        assert_eq!(
+            contact_points(&p, &d1, &q, &d2),
+            closest_on_segments(&p, &d1, &q, &d2)
+        );
     }
 
     /// The smooth law: the harmonic law's force at contact, none from the range on, and a slope

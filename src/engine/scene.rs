@@ -162,9 +162,9 @@ fn check_fits_box(d: &Dumbbell, b: &PeriodicBox) -> Result<()> {
 /// Default tolerance of the averaged model's adaptive integrator.
 pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 
-/// Default tolerance of `suspension(tol)`, the averaged model's default for a suspension: on 1,000
-/// swimmers at volume fraction 0.3% with steric contacts, 100 periods, it keeps the swimmers'
-/// displacements within 3.1e-5 (RMS, relative) of RK4 at T/128 (README, "Suspensions").
+/// Default tolerance of `suspension(tol)`, the averaged model's default for a suspension: the
+/// loosest decade whose displacements stay well within 1e-3 (RMS, relative) of fine RK4 on a
+/// suspension with steric contacts (README, "Bulk suspensions at speed").
 pub const DEFAULT_SUSPENSION_TOL: f64 = 1e-3;
 
 /// From this many swimmers an averaged scene counts as a suspension (whatever its settings).

@@ -690,15 +690,15 @@ impl OdeSystem for AveragedSystem {
 
     fn step_error_norm(
         &self,
-        y: &[f64],
-        y_new: &[f64],
+        _y: &[f64],
+        _y_new: &[f64],
         err: &[f64],
         h: f64,
         f0: &[f64],
         tol: f64,
     ) -> f64 {
         let mut e = vec![0.0; self.coef.len()];
-        self.swimmer_errors(y, y_new, err, h, f0, tol, None, &mut None, &mut e);
+        self.swimmer_errors(err, h, f0, tol, None, &mut None, &mut e);
         (e.iter().map(|e| e * e).sum::<f64>() / e.len().max(1) as f64).sqrt()
     }
 

@@ -15,8 +15,8 @@ impl Partitioned for AveragedSystem {
 
     fn body_errors(
         &self,
-        y: &[f64],
-        y_new: &[f64],
+        _y: &[f64],
+        _y_new: &[f64],
         err: &[f64],
         h: f64,
         f0: &[f64],
@@ -25,7 +25,7 @@ impl Partitioned for AveragedSystem {
         floor: &mut Option<Vec<f64>>,
         out: &mut [f64],
     ) {
-        self.swimmer_errors(y, y_new, err, h, f0, tol, bodies, floor, out);
+        self.swimmer_errors(err, h, f0, tol, bodies, floor, out);
     }
 
     fn partners(&self, bodies: &[usize], out: &mut Vec<usize>) {
