@@ -14,6 +14,9 @@ use std::sync::mpsc;
 use std::time::Duration;
 use swimlab::script::{interrupt, run_source};
 
+mod common;
+use common::Rng;
+
 /// Scripts per run: every template is drawn ~60 times, and the run stays well under a minute
 /// (most statements of hostile arguments stop at their first check).
 const SCRIPTS: usize = 800;
@@ -33,21 +36,6 @@ fn from_env<T: std::str::FromStr>(name: &str, default: T) -> T {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(default)
-}
-
-/// SplitMix64.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn pick<'a>(&mut self, from: &[&'a str]) -> &'a str {
-        from[(self.next() % from.len() as u64) as usize]
-    }
 }
 
 /// Argument values `V`: ordinary, extreme, of the wrong type, and the newer types.

@@ -10,6 +10,9 @@ use std::sync::mpsc;
 use std::time::Duration;
 use swimlab::script::{interrupt, run_source};
 
+mod common;
+use common::Rng;
+
 /// Scripts per run: enough to touch every template many times (~1 minute of CI time).
 const SCRIPTS: usize = 300;
 /// Statements per script.
@@ -18,21 +21,6 @@ const STATEMENTS: usize = 6;
 const PATIENCE: Duration = Duration::from_secs(3);
 /// ...and must then stop within this (a step of any scene here is far below a millisecond).
 const STOP_WITHIN: Duration = Duration::from_secs(10);
-
-/// SplitMix64: the same scripts on every machine.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn pick<'a>(&mut self, from: &[&'a str]) -> &'a str {
-        from[(self.next() % from.len() as u64) as usize]
-    }
-}
 
 /// Argument values: ordinary, extreme, and of the wrong type.
 const VALUES: &[&str] = &[

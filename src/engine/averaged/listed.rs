@@ -145,13 +145,14 @@ impl AveragedSystem {
         self.listed.list.as_ref()
     }
 
-    /// The neighbour list and its slot arrays (lists in use, built).
+    /// The neighbour list and its slot arrays. Only called with lists in use after `fill` and
+    /// `update_list`, which builds a list whenever lists are in use: never without one.
     pub(super) fn listed_parts(&self) -> (&NeighbourList, &Soa) {
         let list = self
             .listed
             .list
             .as_ref()
-            .expect("a neighbour list is built");
+            .expect("update_list builds a list whenever lists are in use");
         (list, &self.listed.slots)
     }
 

@@ -469,16 +469,21 @@ impl AveragedSystem {
     /// Fill the structure of arrays and the sphere centres (length ℓ) from the state `y`.
     fn fill(&mut self, y: &[f64]) {
         for s in 0..self.coef.len() {
-            let c = self.center(y, s);
-            let n = vec3(y, STATE_PER_SWIMMER * s + 3);
-            let soa = &mut self.soa;
-            (soa.x[s], soa.y[s], soa.z[s]) = (c.x, c.y, c.z);
-            (soa.nx[s], soa.ny[s], soa.nz[s]) = (n.x, n.y, n.z);
-            let b = n * self.coef[s].ell;
-            let (w1, w2) = self.weights[s];
-            self.sphere_pos[2 * s] = c - w2 * b;
-            self.sphere_pos[2 * s + 1] = c + w1 * b;
+            self.fill_swimmer(y, s);
         }
+    }
+
+    /// Swimmer `s`'s entries of the arrays and its sphere centres from the state `y`.
+    fn fill_swimmer(&mut self, y: &[f64], s: usize) {
+        let c = self.center(y, s);
+        let n = vec3(y, STATE_PER_SWIMMER * s + 3);
+        let soa = &mut self.soa;
+        (soa.x[s], soa.y[s], soa.z[s]) = (c.x, c.y, c.z);
+        (soa.nx[s], soa.ny[s], soa.nz[s]) = (n.x, n.y, n.z);
+        let b = n * self.coef[s].ell;
+        let (w1, w2) = self.weights[s];
+        self.sphere_pos[2 * s] = c - w2 * b;
+        self.sphere_pos[2 * s + 1] = c + w1 * b;
     }
 
     /// sin(φσ − φρ) if the pair interacts (it is not skipped as a zero-phase pair).

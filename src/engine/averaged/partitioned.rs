@@ -6,7 +6,6 @@
 
 use super::{list_rows, AveragedSystem, STATE_PER_SWIMMER};
 use crate::engine::integrators::{GroupJacobian, Partitioned};
-use crate::engine::model::vec3;
 
 impl Partitioned for AveragedSystem {
     fn body_size(&self) -> usize {
@@ -59,18 +58,18 @@ impl Partitioned for AveragedSystem {
         let incremental = self.uses_lists() && self.listed_list().is_some();
         if incremental {
             for &s in changed {
-                self.refresh_soa(y, s);
+                self.fill_swimmer(y, s);
             }
             // Swimmers that left their lists are relisted (their new ghosts need the slot
             // arrays refilled); the others' slot entries follow their new states.
-            let moved: Vec<usize> = {
-                let (list, soa) = (self.listed_list().expect("lists in use"), &self.soa);
+            let soa = &self.soa;
+            let moved: Vec<usize> = self.listed_list().map_or_else(Vec::new, |list| {
                 changed
                     .iter()
                     .copied()
                     .filter(|&s| !list.holds(s, soa.x[s], soa.y[s], soa.z[s]))
                     .collect()
-            };
+            });
             if !moved.is_empty() && self.relist(Some(moved)) {
                 self.refill_slots();
             } else {
@@ -111,9 +110,6 @@ impl Partitioned for AveragedSystem {
                 dy[STATE_PER_SWIMMER * s..STATE_PER_SWIMMER * (s + 1)].copy_from_slice(&out);
             }
         } else {
-            if incremental {
-                unreachable!("incremental evaluation needs neighbour lists");
-            }
             let vector = self.vector_rows();
             for &s in bodies {
                 self.row_rates(s, y, vector, &mut out);
@@ -148,19 +144,6 @@ impl Partitioned for AveragedSystem {
 }
 
 impl AveragedSystem {
-    /// Swimmer `s`'s entries of the arrays in state order from state `y`.
-    fn refresh_soa(&mut self, y: &[f64], s: usize) {
-        let c = self.center(y, s);
-        let n = vec3(y, STATE_PER_SWIMMER * s + 3);
-        let soa = &mut self.soa;
-        (soa.x[s], soa.y[s], soa.z[s]) = (c.x, c.y, c.z);
-        (soa.nx[s], soa.ny[s], soa.nz[s]) = (n.x, n.y, n.z);
-        let b = n * self.coef[s].ell;
-        let (w1, w2) = self.weights[s];
-        self.sphere_pos[2 * s] = c - w2 * b;
-        self.sphere_pos[2 * s + 1] = c + w1 * b;
-    }
-
     /// Swimmer `s`'s slot entries from its entries in state order.
     fn refresh_slot(&mut self, s: usize) {
         let soa = &self.soa;

@@ -131,12 +131,7 @@ impl Suspension {
         for i in 0..4 {
             // Stage argument, and h times the Γ-combination of the earlier stages.
             for m in 0..n {
-                let mut ya = y[m];
-                let mut ga = 0.0;
-                for j in 0..i {
-                    ya += A[i][j] * self.k[j][m];
-                    ga += G[i][j] * self.k[j][m];
-                }
+                let (ya, ga) = stage_sums(&self.k, i, y[m], m);
                 self.tmp[m] = ya;
                 self.acc[m] = h * ga;
             }
@@ -161,14 +156,7 @@ impl Suspension {
             jac.solve_shifted(&lus, k);
         }
         for m in 0..n {
-            let mut ynew = y[m];
-            let mut e = 0.0;
-            for i in 0..4 {
-                ynew += B[i] * self.k[i][m];
-                e += (B[i] - B_EMBEDDED[i]) * self.k[i][m];
-            }
-            self.y_new[m] = ynew;
-            self.err[m] = e;
+            (self.y_new[m], self.err[m]) = solution(&self.k, y[m], m);
         }
     }
 }
@@ -316,12 +304,7 @@ impl Suspension {
         let lus = jac.factor_shifted(h * GAMMA);
         for i in 0..4 {
             for m in comps() {
-                let mut ya = sub.y0[m];
-                let mut ga = 0.0;
-                for j in 0..i {
-                    ya += A[i][j] * sub.k[j][m];
-                    ga += G[i][j] * sub.k[j][m];
-                }
+                let (ya, ga) = stage_sums(&sub.k, i, sub.y0[m], m);
                 sub.yw[m] = ya;
                 sub.acc[m] = h * ga;
             }
@@ -342,14 +325,7 @@ impl Suspension {
             jac.solve_shifted(&lus, k);
         }
         for m in comps() {
-            let mut y1 = sub.y0[m];
-            let mut e = 0.0;
-            for i in 0..4 {
-                y1 += B[i] * sub.k[i][m];
-                e += (B[i] - B_EMBEDDED[i]) * sub.k[i][m];
-            }
-            sub.y1[m] = y1;
-            sub.err[m] = e;
+            (sub.y1[m], sub.err[m]) = solution(&sub.k, sub.y0[m], m);
         }
         let mut fl = Some(floor.to_vec());
         p.body_errors(
@@ -565,6 +541,29 @@ impl Suspension {
         }
         missed
     }
+}
+
+/// Stage `i`'s argument y0 + Σ_j A_ij k_j and the Γ-combination Σ_j Γ_ij k_j of the earlier
+/// stages `k`, at component `m` (state `y0` there).
+#[inline]
+fn stage_sums(k: &[Vec<f64>; 4], i: usize, y0: f64, m: usize) -> (f64, f64) {
+    let (mut ya, mut ga) = (y0, 0.0);
+    for j in 0..i {
+        ya += A[i][j] * k[j][m];
+        ga += G[i][j] * k[j][m];
+    }
+    (ya, ga)
+}
+
+/// The step's new state and its embedded error estimate at component `m` from the stages `k`.
+#[inline]
+fn solution(k: &[Vec<f64>; 4], y0: f64, m: usize) -> (f64, f64) {
+    let (mut y1, mut e) = (y0, 0.0);
+    for i in 0..4 {
+        y1 += B[i] * k[i][m];
+        e += (B[i] - B_EMBEDDED[i]) * k[i][m];
+    }
+    (y1, e)
 }
 
 /// The groups of `bodies` (sorted) that read one another's states, directly or through others of
