@@ -276,15 +276,16 @@ impl NeighbourList {
         for j in old {
             let kj = self.slot_of[j] as usize;
             let row = &mut self.far[kj];
-            let keep: Vec<(u32, f64)> = row
-                .0
-                .iter()
-                .zip(&row.1)
-                .filter(|(q, _)| **q != pad_slot && !own.contains(q))
-                .map(|(q, w)| (*q, *w))
-                .collect();
-            row.0 = keep.iter().map(|e| e.0).collect();
-            row.1 = keep.iter().map(|e| e.1).collect();
+            unpad(row, pad_slot);
+            let mut i = 0;
+            while i < row.0.len() {
+                if own.contains(&row.0[i]) {
+                    row.0.remove(i);
+                    row.1.remove(i);
+                } else {
+                    i += 1;
+                }
+            }
             pad(row, pad_slot);
             self.near[kj].retain(|q| !own.contains(q));
         }
@@ -306,17 +307,10 @@ impl NeighbourList {
             let kj = self.slot_of[j] as usize;
             if let Some(w) = w {
                 let row = &mut self.far[kj];
-                let mut entries: Vec<(u32, f64)> = row
-                    .0
-                    .iter()
-                    .zip(&row.1)
-                    .filter(|(q, _)| **q != pad_slot)
-                    .map(|(q, w)| (*q, *w))
-                    .collect();
-                let at = entries.partition_point(|e| e.0 < slot);
-                entries.insert(at, (slot, w));
-                row.0 = entries.iter().map(|e| e.0).collect();
-                row.1 = entries.iter().map(|e| e.1).collect();
+                unpad(row, pad_slot);
+                let at = row.0.partition_point(|&q| q < slot);
+                row.0.insert(at, slot);
+                row.1.insert(at, w);
                 pad(row, pad_slot);
             }
             if near {
@@ -445,6 +439,15 @@ impl NeighbourList {
             slot
         };
         self.order[slot] as usize
+    }
+}
+
+/// Take a far row's trailing pad entries off (the pad slot sorts before ghost slots, so the
+/// row's real entries are those before its trailing pads).
+fn unpad(row: &mut (Vec<u32>, Vec<f64>), pad_slot: u32) {
+    while row.0.last() == Some(&pad_slot) {
+        row.0.pop();
+        row.1.pop();
     }
 }
 

@@ -37,7 +37,12 @@ type Contact = (usize, usize, Vector3<f64>);
 
 impl AveragedSystem {
     /// Swimmer `s`'s sphere centres at centre `c` and orientation `n` (length ℓ).
-    fn spheres_at(&self, s: usize, c: Vector3<f64>, n: Vector3<f64>) -> [Vector3<f64>; 2] {
+    pub(super) fn spheres_at(
+        &self,
+        s: usize,
+        c: Vector3<f64>,
+        n: Vector3<f64>,
+    ) -> [Vector3<f64>; 2] {
         let b = n * self.coef[s].ell;
         let (w1, w2) = self.weights[s];
         [c - w2 * b, c + w1 * b]
@@ -168,7 +173,6 @@ impl AveragedSystem {
         for (c, &k) in contacts.iter().zip(&of_contact) {
             by_cluster[k].push(*c);
         }
-        let ell = self.coef.iter().map(|c| c.ell).fold(0.0, f64::max);
         let blocks_of = |(cluster, contacts): (&Vec<usize>, &Vec<Contact>)| {
             let groups: Vec<Vec<usize>> = if cluster.len() > MAX_CLUSTER_SWIMMERS {
                 cluster.iter().map(|&s| vec![s]).collect()
@@ -192,8 +196,9 @@ impl AveragedSystem {
                 for (q, &s) in group.iter().enumerate() {
                     for c in 0..6 {
                         let i = STATE_PER_SWIMMER * s + c;
-                        // A millionth of ℓ for a centre, of a radian for an orientation.
-                        let eps = if c < 3 { 1e-6 * ell } else { 1e-6 };
+                        // A millionth of the swimmer's ℓ for a centre, of a radian for an
+                        // orientation.
+                        let eps = if c < 3 { 1e-6 * self.coef[s].ell } else { 1e-6 };
                         self.cluster_rates(y, Some((i, y[i] + eps)), &group, &inside, &mut col);
                         for r in 0..m {
                             block[r * m + 6 * q + c] = (col[r] - base[r]) / eps;
@@ -257,20 +262,40 @@ impl AveragedSystem {
                 .collect()
         });
         let one = |s: usize| {
-            let mut sum = 0.0;
-            for (kind, fl) in fl.iter().enumerate() {
-                let i = STATE_PER_SWIMMER * s + 3 * kind;
-                let e = norm3(err, i);
-                if e > 0.0 {
-                    sum += (e / (tol * motion(i).max(fl * h))).powi(2);
-                }
-            }
-            (0.5 * sum).sqrt()
+            let i = STATE_PER_SWIMMER * s;
+            let e = [0, 3].map(|o| Vector3::new(err[i + o], err[i + o + 1], err[i + o + 2]));
+            self.error_of(s, e, h, f0, tol, fl)
         };
         match bodies {
             Some(b) => b.iter().for_each(|&s| out[s] = one(s)),
             None => (0..n).for_each(|s| out[s] = one(s)),
         }
+    }
+}
+
+impl AveragedSystem {
+    /// Swimmer `s`'s error of a step `h` whose error in its centre and orientation is `e`,
+    /// against the motion its rates `f0` predict, floored at `floor` (per unit of step) per
+    /// kind: the RMS of the two kinds' |e| / (tol · max(h·|rate|, h·floor)).
+    pub(super) fn error_of(
+        &self,
+        s: usize,
+        e: [Vector3<f64>; 2],
+        h: f64,
+        f0: &[f64],
+        tol: f64,
+        floor: &[f64],
+    ) -> f64 {
+        let mut sum = 0.0;
+        for (kind, fl) in floor.iter().enumerate() {
+            let i = STATE_PER_SWIMMER * s + 3 * kind;
+            let motion = h * vec3(f0, i).norm();
+            let e = e[kind].norm();
+            if e > 0.0 {
+                sum += (e / (tol * motion.max(fl * h))).powi(2);
+            }
+        }
+        (0.5 * sum).sqrt()
     }
 }
 

@@ -156,12 +156,6 @@ impl AveragedSystem {
         (list, &self.listed.slots)
     }
 
-    /// The steric forces on swimmer `s`'s spheres from its near partners (lists in use).
-    pub(super) fn steric_of(&self, st: Steric, s: usize) -> [Vector3<f64>; 2] {
-        let (list, slots) = self.listed_parts();
-        self.slot_steric(st, list, slots, list.slot_of[s] as usize)
-    }
-
     /// Swimmer `s`'s slot entries (its slot and ghosts) from its centre `c` and orientation `n`.
     pub(super) fn refresh_slots(&mut self, s: usize, c: [f64; 3], n: [f64; 3]) {
         let Some(list) = &self.listed.list else {

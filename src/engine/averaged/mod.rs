@@ -494,71 +494,85 @@ impl AveragedSystem {
 
     /// dR_H/dt of swimmer σ and the torque-like sum T (dN/dt = −(1 − NNᵀ) T), from the arrays.
     fn row(&self, s: usize) -> (Vector3<f64>, Vector3<f64>) {
-        let c = &self.coef[s];
         let soa = &self.soa;
         let ns = Vector3::new(soa.nx[s], soa.ny[s], soa.nz[s]);
-        let with_i = c.a_r != 0.0 || !self.skip_symmetric;
-        let with_k = c.a_n != 0.0 || !self.skip_symmetric;
         let mut v = Vector3::zeros();
         let mut t = Vector3::zeros();
-        // Partner r's data from `src` at slot k (the arrays themselves, or their cell-ordered copy).
-        let mut pair = |src: &Soa, k: usize, sin: f64| {
-            let dvec = separation(
-                self.periodic.as_ref(),
-                Vector3::new(
-                    soa.x[s] - src.x[k],
-                    soa.y[s] - src.y[k],
-                    soa.z[s] - src.z[k],
-                ),
-            );
-            let d2 = dvec.norm_squared();
-            if d2 > self.cutoff2 {
-                return;
-            }
-            let dist = d2.sqrt();
-            let sin = sin * self.switch.at(dist);
-            let dh = dvec / dist;
-            let nr = Vector3::new(src.nx[k], src.ny[k], src.nz[k]);
-            let (ss, rr, q) = (dh.dot(&ns), dh.dot(&nr), ns.dot(&nr));
-            let xi = c.ell / dist;
-            let (xi3, xi4) = (xi.powi(3), xi.powi(4));
-            // The bracket shared by J and K.
-            let jk = 1.0 + 2.0 * q * q - 5.0 * ss * ss - 5.0 * rr * rr - 20.0 * q * ss * rr
-                + 35.0 * ss * ss * rr * rr;
-            v += c.c_j
-                * c.v0
-                * sin
-                * (9.0 / 64.0)
-                * xi4
-                * (ns * (2.0 * ss + 4.0 * q * rr - 10.0 * ss * rr * rr) + dh * jk);
-            let l = c.w0
-                * sin
-                * (15.0 / 64.0)
-                * c.big_l
-                * xi4
-                * xi
-                * (3.0 * ss + 6.0 * rr * q + 6.0 * ss * q * q
-                    - 7.0 * ss.powi(3)
-                    - 21.0 * ss * rr * rr
-                    - 42.0 * q * ss * ss * rr
-                    + 63.0 * ss.powi(3) * rr * rr);
-            let mut tr = dh * l;
-            if with_i {
-                let i_br = 1.0 - 3.0 * rr * rr - 3.0 * ss * ss - 6.0 * q * ss * rr
-                    + 15.0 * ss * ss * rr * rr;
-                v += ns * (c.a_r * c.v0 * sin * (9.0 / 64.0) * c.big_l * xi3 * i_br);
-            }
-            if with_k {
-                tr += dh * (c.a_n * c.w0 * sin * (9.0 / 32.0) * c.big_l * xi4 * jk);
-            }
-            t += tr;
-        };
         for r in 0..self.coef.len() {
             if let Some(sin) = self.pair_sin(s, r) {
-                pair(soa, r, sin);
+                let dvec = separation(
+                    self.periodic.as_ref(),
+                    Vector3::new(
+                        soa.x[s] - soa.x[r],
+                        soa.y[s] - soa.y[r],
+                        soa.z[s] - soa.z[r],
+                    ),
+                );
+                let nr = Vector3::new(soa.nx[r], soa.ny[r], soa.nz[r]);
+                self.add_pair_terms(s, ns, dvec, nr, sin, &mut v, &mut t);
             }
         }
         (v, t)
+    }
+
+    /// Add to swimmer σ's far-field sums (dR_H/dt `v`, torque-like `t`) one partner's terms, σ
+    /// with orientation `ns`, the partner at separation `dvec` (σ's centre minus the partner's,
+    /// the image met) with orientation `nr` and pair phase sine `sin`; none beyond the cutoff.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn add_pair_terms(
+        &self,
+        s: usize,
+        ns: Vector3<f64>,
+        dvec: Vector3<f64>,
+        nr: Vector3<f64>,
+        sin: f64,
+        v: &mut Vector3<f64>,
+        t: &mut Vector3<f64>,
+    ) {
+        let c = &self.coef[s];
+        let d2 = dvec.norm_squared();
+        if d2 > self.cutoff2 {
+            return;
+        }
+        let with_i = c.a_r != 0.0 || !self.skip_symmetric;
+        let with_k = c.a_n != 0.0 || !self.skip_symmetric;
+        let dist = d2.sqrt();
+        let sin = sin * self.switch.at(dist);
+        let dh = dvec / dist;
+        let (ss, rr, q) = (dh.dot(&ns), dh.dot(&nr), ns.dot(&nr));
+        let xi = c.ell / dist;
+        let (xi3, xi4) = (xi.powi(3), xi.powi(4));
+        // The bracket shared by J and K.
+        let jk = 1.0 + 2.0 * q * q - 5.0 * ss * ss - 5.0 * rr * rr - 20.0 * q * ss * rr
+            + 35.0 * ss * ss * rr * rr;
+        *v += c.c_j
+            * c.v0
+            * sin
+            * (9.0 / 64.0)
+            * xi4
+            * (ns * (2.0 * ss + 4.0 * q * rr - 10.0 * ss * rr * rr) + dh * jk);
+        let l = c.w0
+            * sin
+            * (15.0 / 64.0)
+            * c.big_l
+            * xi4
+            * xi
+            * (3.0 * ss + 6.0 * rr * q + 6.0 * ss * q * q
+                - 7.0 * ss.powi(3)
+                - 21.0 * ss * rr * rr
+                - 42.0 * q * ss * ss * rr
+                + 63.0 * ss.powi(3) * rr * rr);
+        let mut tr = dh * l;
+        if with_i {
+            let i_br =
+                1.0 - 3.0 * rr * rr - 3.0 * ss * ss - 6.0 * q * ss * rr + 15.0 * ss * ss * rr * rr;
+            *v += ns * (c.a_r * c.v0 * sin * (9.0 / 64.0) * c.big_l * xi3 * i_br);
+        }
+        if with_k {
+            tr += dh * (c.a_n * c.w0 * sin * (9.0 / 32.0) * c.big_l * xi4 * jk);
+        }
+        *t += tr;
     }
 
     /// The 1D reduction: speed of swimmer σ along the axis (its centre coordinate in `soa.x`).

@@ -4,8 +4,10 @@
 //! few swimmers cost what their own rows cost: with neighbour lists, only the slot entries of the
 //! swimmers that moved are refreshed.
 
-use super::{list_rows, AveragedSystem, STATE_PER_SWIMMER};
+use super::{vec3, AveragedSystem, STATE_PER_SWIMMER};
 use crate::engine::integrators::{GroupJacobian, Partitioned};
+use crate::engine::periodic::separation;
+use nalgebra::Vector3;
 
 impl Partitioned for AveragedSystem {
     fn body_size(&self) -> usize {
@@ -55,25 +57,25 @@ impl Partitioned for AveragedSystem {
         changed: &[usize],
         dy: &mut [f64],
     ) {
-        let incremental = self.uses_lists() && self.listed_list().is_some();
-        if incremental {
-            for &s in changed {
+        if self.rates_shared(y, bodies, changed, dy) {
+            return;
+        }
+        if self.shares_rates() {
+            // Swimmers that left their lists are relisted (their array and slot entries set from
+            // `y` first, as a relisting reads them; new ghosts need the slot arrays refilled).
+            // Nothing else is written: the rates read the states from `y`.
+            let moved: Vec<usize> = changed
+                .iter()
+                .copied()
+                .filter(|&s| !self.holds(y, s))
+                .collect();
+            for &s in &moved {
                 self.fill_swimmer(y, s);
             }
-            // Swimmers that left their lists are relisted (their new ghosts need the slot
-            // arrays refilled); the others' slot entries follow their new states.
-            let soa = &self.soa;
-            let moved: Vec<usize> = self.listed_list().map_or_else(Vec::new, |list| {
-                changed
-                    .iter()
-                    .copied()
-                    .filter(|&s| !list.holds(s, soa.x[s], soa.y[s], soa.z[s]))
-                    .collect()
-            });
-            if !moved.is_empty() && self.relist(Some(moved)) {
+            if self.relist(Some(moved.clone())) {
                 self.refill_slots();
             } else {
-                for &s in changed {
+                for &s in &moved {
                     self.refresh_slot(s);
                 }
             }
@@ -94,23 +96,11 @@ impl Partitioned for AveragedSystem {
                 );
             }
         }
-        let mut out = [0.0; STATE_PER_SWIMMER];
         if self.uses_lists() {
-            if let Some(st) = self.contacts.steric {
-                for &s in bodies {
-                    let f = self.steric_of(st, s);
-                    self.steric_f[2 * s] = f[0];
-                    self.steric_f[2 * s + 1] = f[1];
-                }
-            }
-            for &s in bodies {
-                let (list, slots) = self.listed_parts();
-                let (v, t) = list_rows::row(self, list, slots, list.slot_of[s] as usize);
-                self.finish_rates(s, y, v, t, &mut out);
-                dy[STATE_PER_SWIMMER * s..STATE_PER_SWIMMER * (s + 1)].copy_from_slice(&out);
-            }
+            self.listed_rates(y, bodies, dy);
         } else {
             let vector = self.vector_rows();
+            let mut out = [0.0; STATE_PER_SWIMMER];
             for &s in bodies {
                 self.row_rates(s, y, vector, &mut out);
                 dy[STATE_PER_SWIMMER * s..STATE_PER_SWIMMER * (s + 1)].copy_from_slice(&out);
@@ -119,7 +109,7 @@ impl Partitioned for AveragedSystem {
     }
 
     fn stiff_groups_of(
-        &mut self,
+        &self,
         _t: f64,
         y: &[f64],
         bodies: &[usize],
@@ -141,9 +131,139 @@ impl Partitioned for AveragedSystem {
         }
         Ok(self.jacobian_of(y, &contacts))
     }
+
+    fn shares_rates(&self) -> bool {
+        self.uses_lists() && self.listed_list().is_some()
+    }
+
+    fn rates_shared(&self, y: &[f64], bodies: &[usize], changed: &[usize], dy: &mut [f64]) -> bool {
+        if !self.shares_rates() || !changed.iter().all(|&s| self.holds(y, s)) {
+            return false;
+        }
+        self.listed_rates(y, bodies, dy);
+        true
+    }
+
+    fn read_errors(
+        &self,
+        before: &[f64],
+        after: &[f64],
+        bodies: &[usize],
+        sources: &[usize],
+        h: f64,
+        f0: &[f64],
+        tol: f64,
+        floor: &[f64],
+        out: &mut [f64],
+    ) {
+        let periodic = self.periodic.as_ref();
+        let mut partners = Vec::new();
+        for &s in bodies {
+            // The sources among s's partners: through its list rows, or all of them.
+            partners.clear();
+            match self.listed_list() {
+                Some(list) => {
+                    let k = list.slot_of[s] as usize;
+                    for &q in list.far_row(k).0.iter().chain(list.near_row(k)) {
+                        if q as usize != list.pad_slot() {
+                            let r = list.swimmer_of(q as usize);
+                            if sources.binary_search(&r).is_ok() {
+                                partners.push(r);
+                            }
+                        }
+                    }
+                    partners.sort_unstable();
+                    partners.dedup();
+                }
+                None => partners.extend(sources.iter().filter(|&&r| r != s)),
+            }
+            let cs = self.center(before, s);
+            let ns = vec3(before, STATE_PER_SWIMMER * s + 3);
+            let (mut dv, mut dt) = (Vector3::zeros(), Vector3::zeros());
+            for &r in &partners {
+                let Some(sin) = self.pair_sin(s, r) else {
+                    continue;
+                };
+                let terms = |y: &[f64]| {
+                    let (mut v, mut t) = (Vector3::zeros(), Vector3::zeros());
+                    let d = separation(periodic, cs - self.center(y, r));
+                    let nr = vec3(y, STATE_PER_SWIMMER * r + 3);
+                    self.add_pair_terms(s, ns, d, nr, sin, &mut v, &mut t);
+                    (v, t)
+                };
+                let ((va, ta), (vb, tb)) = (terms(before), terms(after));
+                dv += vb - va;
+                dt += tb - ta;
+            }
+            let dn = -(dt - ns * ns.dot(&dt));
+            out[s] = self.error_of(s, [dv * h, dn * h], h, f0, tol, floor);
+        }
+    }
 }
 
 impl AveragedSystem {
+    /// Whether swimmer `s`, at its centre in state `y`, is still within its list's skin (a list
+    /// in use).
+    fn holds(&self, y: &[f64], s: usize) -> bool {
+        let c = self.center(y, s);
+        self.listed_list()
+            .is_some_and(|list| list.holds(s, c.x, c.y, c.z))
+    }
+
+    /// The rates of `bodies` at state `y` into their blocks of `dy`
+    /// ([`AveragedSystem::rates_from_state`]).
+    fn listed_rates(&self, y: &[f64], bodies: &[usize], dy: &mut [f64]) {
+        let mut out = [0.0; STATE_PER_SWIMMER];
+        for &s in bodies {
+            self.rates_from_state(y, s, &mut out);
+            dy[STATE_PER_SWIMMER * s..STATE_PER_SWIMMER * (s + 1)].copy_from_slice(&out);
+        }
+    }
+
+    /// Swimmer `s`'s rates at state `y` (after `update_list`), its partners found through its list
+    /// rows and read from `y`, met at their minimum images (the list's images within its radius):
+    /// the far field of [`AveragedSystem::add_pair_terms`] over the far row with its weights,
+    /// the steric forces over the near row.
+    fn rates_from_state(&self, y: &[f64], s: usize, out: &mut [f64]) {
+        let (list, _) = self.listed_parts();
+        let periodic = self.periodic.as_ref();
+        let k = list.slot_of[s] as usize;
+        let pad = list.pad_slot();
+        let cs = self.center(y, s);
+        let ns = vec3(y, STATE_PER_SWIMMER * s + 3);
+        let orientation = |r: usize| vec3(y, STATE_PER_SWIMMER * r + 3);
+        let (mut v, mut t) = (Vector3::zeros(), Vector3::zeros());
+        let (partners, weights) = list.far_row(k);
+        for (&q, &w) in partners.iter().zip(weights) {
+            if q as usize == pad {
+                break;
+            }
+            let r = list.swimmer_of(q as usize);
+            let d = separation(periodic, cs - self.center(y, r));
+            self.add_pair_terms(s, ns, d, orientation(r), w, &mut v, &mut t);
+        }
+        let mut dn = -(t - ns * ns.dot(&t));
+        if let Some(st) = self.contacts.steric {
+            let a = self.spheres_at(s, cs, ns);
+            let ra = [self.radii[2 * s], self.radii[2 * s + 1]];
+            let mut f = [Vector3::zeros(); 2];
+            for &q in list.near_row(k) {
+                let r = list.swimmer_of(q as usize);
+                let d = separation(periodic, cs - self.center(y, r));
+                let b = self.spheres_at(r, cs - d, orientation(r));
+                let rb = [self.radii[2 * r], self.radii[2 * r + 1]];
+                let df = st.swimmer_pair_forces(a, ra, b, rb);
+                f[0] += df[0];
+                f[1] += df[1];
+            }
+            let (vs, ws) = self.steric_rates_of(s, ns, f);
+            v += vs;
+            dn += ws;
+        }
+        out[..3].copy_from_slice(v.as_slice());
+        out[3..6].copy_from_slice(dn.as_slice());
+    }
+
     /// Swimmer `s`'s slot entries from its entries in state order.
     fn refresh_slot(&mut self, s: usize) {
         let soa = &self.soa;

@@ -22,12 +22,16 @@
 //! of them, each within [`MAX_REFINED_ERROR`] of the tolerance) miss it and the rest meet it,
 //! the rest keep their step, and those few, with every swimmer in contact with them, are stepped
 //! again across the same interval by the same method with steps of their own (adaptive, at
-//! least [`MAX_SUBSTEPS`]), reading the other swimmers' states from the coarse step (quadratic
+//! most [`MAX_SUBSTEPS`]), reading the other swimmers' states from the coarse step (quadratic
 //! through its start, its end and its starting rates; their error is within the tolerance).
-//! What the few did wrong in the coarse step reaches the rest only through the far field, at
-//! most MAX_REFINED_ERROR × tol of their own displacement at a distance of the cutoff; a contact
-//! forming between the few and the rest during the interval rejects the step instead. (Savcenco,
-//! Hundsdorfer & Verwer, BIT 47 (2007) 137, refine a coarse step the same way.)
+//! Groups of refined swimmers that read none of each other's states are stepped apart, on
+//! rayon's threads when the system can give rates without changing (its neighbour lists still
+//! hold the swimmers read). What the few did wrong in the coarse step reaches the rest only
+//! through the far field: the neighbours whose rates change, when they read the refined path
+//! instead of the coarse one, by more than [`RING_SHARE`] of the tolerance (or by more than
+//! their own error leaves to it) are stepped again reading the refined path (the *ring*); a
+//! contact forming between the few and the rest during the interval grows the few instead.
+//! (Savcenco, Hundsdorfer & Verwer, BIT 47 (2007) 137, refine a coarse step the same way.)
 //!
 //! Stage equations (with k including the factor h; autonomous systems skip ∂f/∂t):
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
@@ -37,6 +41,7 @@ use super::system::{
     check_state, fit, stalled, step_too_small, tolerance_failure, GroupJacobian, OdeSystem,
     Partitioned, Stats, StepFailure, Stepper,
 };
+use rayon::prelude::*;
 
 const MAX_REJECTS: u32 = 60;
 
@@ -46,9 +51,16 @@ pub const MAX_REFINED_FRACTION: f64 = 0.05;
 /// The share of swimmers the step size controller aims to leave to refinement.
 pub const REFINED_TARGET_FRACTION: f64 = 0.01;
 
+/// The share of the tolerance by which reading the refined swimmers' path instead of their coarse
+/// states may change a neighbour's step before the neighbour is stepped again.
+pub const RING_SHARE: f64 = 0.1;
+
 /// Rounds of refining and stepping the ring again before a step is given up (each round adds the
 /// ring swimmers that missed the tolerance to the refined ones).
 pub const RING_ROUNDS: usize = 4;
+
+/// Refined groups from this many on are refined on rayon's threads (when the system allows).
+pub const PARALLEL_GROUPS: usize = 2;
 
 /// The most steps a refinement may take across one coarse step.
 pub const MAX_SUBSTEPS: u32 = 100_000;
@@ -71,6 +83,10 @@ pub struct Suspension {
     err: Vec<f64>,
     /// Scratch of the refinement (full length; only the refined swimmers' entries are used).
     sub: Refinement,
+    /// Scratch of refinements on rayon's threads.
+    pool: Pool,
+    /// States at the step's middle and end, coarse and refined ([`Suspension::ring_of`]).
+    views: [(Vec<f64>, Vec<f64>); 2],
     /// Each group of refined swimmers' components and path across the coarse step: (time from
     /// its start, their states).
     paths: Vec<(Vec<usize>, Path)>,
@@ -94,6 +110,102 @@ struct Refinement {
     errors: Vec<f64>,
 }
 
+impl Refinement {
+    /// Sized to a state of `n` components (and at least `bodies` bodies). Entries are not
+    /// reset: a refinement on shared access writes every entry it reads (its bodies' and the
+    /// states they read).
+    fn fit(&mut self, n: usize, bodies: usize) {
+        let [k1, k2, k3, k4] = &mut self.k;
+        for v in [
+            k1,
+            k2,
+            k3,
+            k4,
+            &mut self.yw,
+            &mut self.y0,
+            &mut self.f,
+            &mut self.f0,
+            &mut self.acc,
+            &mut self.y1,
+            &mut self.err,
+        ] {
+            v.resize(n, 0.0);
+        }
+        if self.errors.len() < bodies {
+            self.errors.resize(bodies, 0.0);
+        }
+    }
+}
+
+/// Scratch for refinements on several threads (a clone starts empty).
+#[derive(Debug, Default)]
+struct Pool(std::sync::Mutex<Vec<Refinement>>);
+
+impl Clone for Pool {
+    fn clone(&self) -> Self {
+        Pool::default()
+    }
+}
+
+/// A refined group's outcome: its state components, its path across the coarse step and the
+/// steps it took.
+struct Refined {
+    comps: Vec<usize>,
+    path: Path,
+    steps: u64,
+}
+
+/// Why a refinement or a subset step stopped.
+#[derive(Debug)]
+enum Refusal {
+    /// A contact forms between the bodies stepped and others: the bodies of every such contact.
+    Crossing(Vec<usize>),
+    /// The steps shrank to nothing.
+    Failed,
+    /// The system's neighbour data must change first (read shared, it cannot).
+    Relist,
+}
+
+/// How a refinement reaches the system: owned (rates through [`Partitioned::rhs_bodies`], which
+/// may update the system) or shared among threads (through [`Partitioned::rates_shared`]).
+enum Access<'a> {
+    Own(&'a mut dyn Partitioned),
+    Shared(&'a dyn Partitioned),
+}
+
+impl Access<'_> {
+    fn get(&self) -> &dyn Partitioned {
+        match self {
+            Access::Own(p) => &**p,
+            Access::Shared(p) => *p,
+        }
+    }
+
+    /// The rates of `bodies` at `y` into `dy` (see [`Partitioned::rhs_bodies`]).
+    fn rates(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        bodies: &[usize],
+        changed: &[usize],
+        dy: &mut [f64],
+    ) -> Result<(), Refusal> {
+        match self {
+            Access::Own(p) => {
+                p.rhs_bodies(t, y, bodies, changed, dy);
+                Ok(())
+            }
+            Access::Shared(p) => {
+                if p.rates_shared(y, bodies, changed, dy) {
+                    Ok(())
+                } else {
+                    Err(Refusal::Relist)
+                }
+            }
+        }
+    }
+}
+
 impl Suspension {
     /// A stepper at tolerance `tol` whose first step is `first_step` (s).
     pub fn new(tol: f64, first_step: f64) -> Self {
@@ -110,6 +222,8 @@ impl Suspension {
             y_new: Vec::new(),
             err: Vec::new(),
             sub: Refinement::default(),
+            pool: Default::default(),
+            views: Default::default(),
             paths: Vec::new(),
         }
     }
@@ -201,9 +315,10 @@ impl Suspension {
         // refine: the error of the swimmer at that quantile.
         let quantile = {
             let mut sorted = e.clone();
-            sorted.sort_by(|a, b| a.total_cmp(b));
             let at = ((1.0 - REFINED_TARGET_FRACTION) * n as f64).floor() as usize;
-            sorted[at.min(n - 1)]
+            *sorted
+                .select_nth_unstable_by(at.min(n - 1), f64::total_cmp)
+                .1
         };
         let most = (MAX_REFINED_FRACTION * n as f64).floor() as usize;
         if fast.len() > most {
@@ -227,34 +342,29 @@ impl Suspension {
         let mut ring = Vec::new();
         let mut steps = 0;
         let mut settled = false;
+        // The coarse step's states: refinement overwrites the refined swimmers' in `y_new`.
+        let coarse = self.y_new.clone();
         for _ in 0..RING_ROUNDS {
-            p.partners(&refined, &mut ring);
-            ring = closure(std::mem::take(&mut ring), jac, bs)
-                .into_iter()
-                .filter(|b| refined.binary_search(b).is_err())
-                .collect();
-            if refined.len() + ring.len() > most.max(1) * 8 {
-                // Stepping again a ring this large costs more than a shorter step for all: the
-                // step the fast swimmers need unrefined.
-                return (worst, false);
-            }
             // Swimmers that read none of each other's states take their own steps.
             self.prepare_sub(y, n);
             self.paths.clear();
             steps = 0;
             // A contact forming between a group and a swimmer outside it: both join the refined
             // swimmers and the round is taken again.
-            let mut grown = Vec::new();
-            for group in groups_of(p, &refined) {
-                match self.refine(p, t, h, y, &group, &floor) {
-                    Ok(taken) => steps += taken,
-                    Err(more) if !more.is_empty() => grown.extend(more),
-                    Err(_) => return (f64::INFINITY, false),
+            let groups = groups_of(p, &refined);
+            match self.refine_groups(p, t, h, y, &coarse, &groups, &floor) {
+                Ok(taken) => steps = taken,
+                Err(Refusal::Crossing(more)) => {
+                    refined = closure(refined.into_iter().chain(more).collect(), jac, bs);
+                    continue;
                 }
+                Err(_) => return (f64::INFINITY, false),
             }
-            if !grown.is_empty() {
-                refined = closure(refined.into_iter().chain(grown).collect(), jac, bs);
-                continue;
+            ring = self.ring_of(p, h, y, &coarse, &refined, &e, &floor, jac);
+            if refined.len() + ring.len() > most.max(1) * 8 {
+                // Stepping again a ring this large costs more than a shorter step for all: the
+                // step the fast swimmers need unrefined.
+                return (worst, false);
             }
             let missed = self.redo_ring(p, t, h, y, &refined, &ring, &floor);
             if missed.is_empty() {
@@ -278,13 +388,13 @@ impl Suspension {
     }
 
     /// One W-method step of `bodies` from `t0` by `h` from their states in `sub.y0`, the other
-    /// states they read set by `read(yw, time)`: fills `sub.y1`, `sub.err`, `sub.f0` for their
-    /// components and returns the RMS of their errors, or the swimmers of contacts forming
-    /// across the edge of `bodies` (both ends).
+    /// states they read set by `read(yw, time)`, the system reached through `p`: fills `sub.y1`,
+    /// `sub.err`, `sub.f0` for their components and returns the RMS of their errors, or why not
+    /// (a contact forming across the edge of `bodies`; shared access that must relist first).
     #[allow(clippy::too_many_arguments)]
     fn subset_step(
         sub: &mut Refinement,
-        p: &mut dyn Partitioned,
+        p: &mut Access,
         tol: f64,
         t0: f64,
         h: f64,
@@ -292,15 +402,18 @@ impl Suspension {
         changed: &[usize],
         floor: &[f64],
         read: &dyn Fn(&mut [f64], f64),
-    ) -> Result<f64, Vec<usize>> {
-        let bs = p.body_size();
+    ) -> Result<f64, Refusal> {
+        let bs = p.get().body_size();
         let comps = || bodies.iter().flat_map(move |&b| b * bs..(b + 1) * bs);
         for m in comps() {
             sub.yw[m] = sub.y0[m];
         }
         read(&mut sub.yw, t0);
-        p.rhs_bodies(t0, &sub.yw, bodies, changed, &mut sub.f0);
-        let jac = p.stiff_groups_of(t0, &sub.yw, bodies)?;
+        p.rates(t0, &sub.yw, bodies, changed, &mut sub.f0)?;
+        let jac = p
+            .get()
+            .stiff_groups_of(t0, &sub.yw, bodies)
+            .map_err(Refusal::Crossing)?;
         let lus = jac.factor_shifted(h * GAMMA);
         for i in 0..4 {
             for m in comps() {
@@ -315,7 +428,7 @@ impl Suspension {
             } else {
                 let c: f64 = A[i].iter().sum();
                 read(&mut sub.yw, t0 + c * h);
-                p.rhs_bodies(t0 + c * h, &sub.yw, bodies, changed, &mut sub.f);
+                p.rates(t0 + c * h, &sub.yw, bodies, changed, &mut sub.f)?;
             }
             let k = &mut sub.k[i];
             for m in comps() {
@@ -328,7 +441,7 @@ impl Suspension {
             (sub.y1[m], sub.err[m]) = solution(&sub.k, sub.y0[m], m);
         }
         let mut fl = Some(floor.to_vec());
-        p.body_errors(
+        p.get().body_errors(
             &sub.y0,
             &sub.y1,
             &sub.err,
@@ -343,30 +456,12 @@ impl Suspension {
         Ok((sum / bodies.len().max(1) as f64).sqrt())
     }
 
-    /// Scratch sized to the state `y`, with the working states at `y`.
+    /// This thread's scratch sized to the state `y`, with the working states at `y` (a
+    /// refinement that relists a swimmer may read a new partner's state before it sets it).
     fn prepare_sub(&mut self, y: &[f64], bodies: usize) {
-        let n = y.len();
-        let sub = &mut self.sub;
-        let [k1, k2, k3, k4] = &mut sub.k;
-        fit(
-            n,
-            &mut [
-                k1,
-                k2,
-                k3,
-                k4,
-                &mut sub.f,
-                &mut sub.f0,
-                &mut sub.acc,
-                &mut sub.y1,
-                &mut sub.err,
-            ],
-        );
-        sub.yw.clear();
-        sub.yw.extend_from_slice(y);
-        sub.y0.clear();
-        sub.y0.extend_from_slice(y);
-        sub.errors.resize(bodies, 0.0);
+        self.sub.fit(y.len(), bodies);
+        self.sub.yw.copy_from_slice(y);
+        self.sub.y0.copy_from_slice(y);
     }
 
     /// The states of components `read` at time `t0 + θh` from the coarse step from `y`: the
@@ -386,22 +481,25 @@ impl Suspension {
         }
     }
 
-    /// Step the swimmers `bodies` again from `t` to `t + h` by steps of their own, the others read
-    /// from the coarse step; their new states go into `y_new` and their path into `self.paths`.
-    /// The steps taken, or `None` when a contact forms with a swimmer outside or the steps
-    /// shrink to nothing.
+    /// Step the swimmers `bodies` again from `t` to `t + h` by steps of their own (scratch
+    /// `sub`), the others read from the coarse step (`coarse`, with rates `f0` at its start):
+    /// their components, path across the step and the steps taken.
+    #[allow(clippy::too_many_arguments)]
     fn refine(
-        &mut self,
-        p: &mut dyn Partitioned,
+        sub: &mut Refinement,
+        p: &mut Access,
+        tol: f64,
         t: f64,
         h: f64,
         y: &[f64],
+        coarse: &[f64],
+        f0: &[f64],
         bodies: &[usize],
         floor: &[f64],
-    ) -> Result<u64, Vec<usize>> {
-        let bs = p.body_size();
+    ) -> Result<Refined, Refusal> {
+        let bs = p.get().body_size();
         let mut partners = Vec::new();
-        p.partners(bodies, &mut partners);
+        p.get().partners(bodies, &mut partners);
         let read: Vec<usize> = partners
             .iter()
             .flat_map(|&b| b * bs..(b + 1) * bs)
@@ -409,13 +507,14 @@ impl Suspension {
         let comps: Vec<usize> = bodies.iter().flat_map(|&b| b * bs..(b + 1) * bs).collect();
         let mut changed: Vec<usize> = bodies.iter().chain(&partners).copied().collect();
         changed.sort_unstable();
+        sub.fit(y.len(), y.len() / bs.max(1));
         for &m in &comps {
-            self.sub.y0[m] = y[m];
+            sub.y0[m] = y[m];
         }
         let mut path = vec![(0.0, comps.iter().map(|&m| y[m]).collect::<Vec<f64>>())];
-        let (y_new, f0) = (&self.y_new, &self.f0);
-        let at =
-            |yw: &mut [f64], time: f64| Self::coarse_at(y, y_new, f0, h, &read, yw, (time - t) / h);
+        let at = |yw: &mut [f64], time: f64| {
+            Self::coarse_at(y, coarse, f0, h, &read, yw, (time - t) / h)
+        };
         let mut tau = 0.0;
         let mut hs = 0.5 * h;
         let mut steps = 0u64;
@@ -423,7 +522,7 @@ impl Suspension {
         while tau < h {
             attempts += 1;
             if attempts > MAX_SUBSTEPS {
-                return Err(Vec::new());
+                return Err(Refusal::Failed);
             }
             let span = h - tau;
             let (h_try, last) = if hs >= span {
@@ -431,25 +530,15 @@ impl Suspension {
             } else {
                 (hs, false)
             };
-            let norm = Self::subset_step(
-                &mut self.sub,
-                p,
-                self.tol,
-                t + tau,
-                h_try,
-                bodies,
-                &changed,
-                floor,
-                &at,
-            );
-            let norm = norm?;
+            let norm =
+                Self::subset_step(sub, p, tol, t + tau, h_try, bodies, &changed, floor, &at)?;
             let fac = controller_factor(norm);
             if norm <= 1.0 && norm.is_finite() {
                 for &m in &comps {
-                    self.sub.y0[m] = self.sub.y1[m];
+                    sub.y0[m] = sub.y1[m];
                 }
                 tau = if last { h } else { tau + h_try };
-                path.push((tau, comps.iter().map(|&m| self.sub.y1[m]).collect()));
+                path.push((tau, comps.iter().map(|&m| sub.y1[m]).collect()));
                 steps += 1;
                 if !(last && h_try < hs) {
                     hs = h_try * fac;
@@ -457,15 +546,174 @@ impl Suspension {
             } else {
                 hs = h_try * fac.min(0.9);
                 if step_too_small(hs, t + tau) || hs < 1e-12 * h {
-                    return Err(Vec::new());
+                    return Err(Refusal::Failed);
                 }
             }
         }
-        for &m in &comps {
-            self.y_new[m] = self.sub.y0[m];
+        Ok(Refined { comps, path, steps })
+    }
+
+    /// Refine every group of `groups` (see [`Suspension::refine`]): on rayon's threads, each
+    /// with scratch of its own, when the system's rates can be read shared; a group whose
+    /// swimmers left the system's neighbour data, and every group otherwise, on this thread.
+    /// Their new states go into `y_new` and their paths into `self.paths`; the steps taken, or
+    /// the refusal of the first group refused.
+    #[allow(clippy::too_many_arguments)]
+    fn refine_groups(
+        &mut self,
+        p: &mut dyn Partitioned,
+        t: f64,
+        h: f64,
+        y: &[f64],
+        coarse: &[f64],
+        groups: &[Vec<usize>],
+        floor: &[f64],
+    ) -> Result<u64, Refusal> {
+        let (tol, f0) = (self.tol, &self.f0);
+        let mut results: Vec<Result<Refined, Refusal>> =
+            if groups.len() >= PARALLEL_GROUPS && p.shares_rates() {
+                let shared: &dyn Partitioned = p;
+                let pool = &self.pool.0;
+                groups
+                    .par_iter()
+                    .map(|group| {
+                        // Scratch from the pool (a thread working on two groups at once, as
+                        // rayon may nest, takes a second).
+                        let mut sub = pool
+                            .lock()
+                            .ok()
+                            .and_then(|mut v| v.pop())
+                            .unwrap_or_default();
+                        let r = Self::refine(
+                            &mut sub,
+                            &mut Access::Shared(shared),
+                            tol,
+                            t,
+                            h,
+                            y,
+                            coarse,
+                            f0,
+                            group,
+                            floor,
+                        );
+                        if let Ok(mut v) = pool.lock() {
+                            v.push(sub);
+                        }
+                        r
+                    })
+                    .collect()
+            } else {
+                groups.iter().map(|_| Err(Refusal::Relist)).collect()
+            };
+        for (group, result) in groups.iter().zip(results.iter_mut()) {
+            if matches!(result, Err(Refusal::Relist)) {
+                *result = Self::refine(
+                    &mut self.sub,
+                    &mut Access::Own(p),
+                    tol,
+                    t,
+                    h,
+                    y,
+                    coarse,
+                    f0,
+                    group,
+                    floor,
+                );
+            }
         }
-        self.paths.push((comps, path));
+        let mut steps = 0;
+        let mut crossing = Vec::new();
+        for result in results {
+            match result {
+                Ok(Refined {
+                    comps,
+                    path,
+                    steps: taken,
+                }) => {
+                    let end = &path.last().expect("a path holds its start").1;
+                    for (&m, &v) in comps.iter().zip(end) {
+                        self.y_new[m] = v;
+                    }
+                    self.paths.push((comps, path));
+                    steps += taken;
+                }
+                Err(Refusal::Crossing(more)) => crossing.extend(more),
+                Err(refusal) => return Err(refusal),
+            }
+        }
+        if !crossing.is_empty() {
+            return Err(Refusal::Crossing(crossing));
+        }
         Ok(steps)
+    }
+
+    /// Into `self.views`, the states at the step's middle and end of the components `comps` (the
+    /// only entries set): from the coarse step (`coarse`, quadratic) and, in the second of each
+    /// pair, the refined swimmers' from their paths.
+    fn coarse_and_refined(&mut self, y: &[f64], coarse: &[f64], h: f64, comps: &[usize]) {
+        let n = y.len();
+        for (theta, (before, after)) in [0.5, 1.0].into_iter().zip(self.views.iter_mut()) {
+            before.resize(n, 0.0);
+            after.resize(n, 0.0);
+            Self::coarse_at(y, coarse, &self.f0, h, comps, before, theta);
+            for &m in comps {
+                after[m] = before[m];
+            }
+            for (path_comps, path) in &self.paths {
+                for (&m, v) in path_comps.iter().zip(path_at(path, theta * h)) {
+                    after[m] = v;
+                }
+            }
+        }
+    }
+
+    /// The swimmers to step again around the refined ones (`refined`, their paths in
+    /// `self.paths`, their coarse states in `coarse`): those whose rates change, when they read
+    /// the refined path instead of the coarse one (at the step's middle and end), by more than
+    /// [`RING_SHARE`] of the tolerance, or by more than their coarse error `e` leaves to it; with
+    /// every swimmer in a stiff group of `jac` with one of them, none refined.
+    #[allow(clippy::too_many_arguments)]
+    fn ring_of(
+        &mut self,
+        p: &dyn Partitioned,
+        h: f64,
+        y: &[f64],
+        coarse: &[f64],
+        refined: &[usize],
+        e: &[f64],
+        floor: &[f64],
+        jac: &GroupJacobian,
+    ) -> Vec<usize> {
+        let bs = p.body_size();
+        let mut near = Vec::new();
+        p.partners(refined, &mut near);
+        let comps: Vec<usize> = refined
+            .iter()
+            .chain(&near)
+            .flat_map(|&b| b * bs..(b + 1) * bs)
+            .collect();
+        let mut read = vec![0.0; e.len()];
+        let mut worst = vec![0.0f64; e.len()];
+        self.coarse_and_refined(y, coarse, h, &comps);
+        for (before, after) in &self.views {
+            p.read_errors(
+                before, after, &near, refined, h, &self.f0, self.tol, floor, &mut read,
+            );
+            for &b in &near {
+                worst[b] = worst[b].max(read[b]);
+            }
+        }
+        let moved: Vec<usize> = near
+            .into_iter()
+            .filter(|&b| {
+                let r = worst[b];
+                r.is_nan() || r > RING_SHARE || r + e[b] > 1.0
+            })
+            .collect();
+        closure(moved, jac, bs)
+            .into_iter()
+            .filter(|b| refined.binary_search(b).is_err())
+            .collect()
     }
 
     /// Take the coarse step again for the swimmers `ring` that read the refined ones, now reading
@@ -504,28 +752,31 @@ impl Suspension {
             Self::coarse_at(y, y_new, f0, h, &others, yw, (time - t) / h);
             let tau = time - t;
             for (comps, path) in paths {
-                let j = path
-                    .partition_point(|(s, _)| *s <= tau)
-                    .clamp(1, path.len() - 1);
-                let ((s0, a), (s1, b)) = (&path[j - 1], &path[j]);
-                let w = if s1 > s0 {
-                    ((tau - s0) / (s1 - s0)).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
-                for (q, &m) in comps.iter().enumerate() {
-                    yw[m] = a[q] + w * (b[q] - a[q]);
+                for (&m, v) in comps.iter().zip(path_at(path, tau)) {
+                    yw[m] = v;
                 }
             }
         };
-        if let Err(crossing) =
-            Self::subset_step(&mut self.sub, p, self.tol, t, h, ring, &changed, floor, &at)
-        {
+        match Self::subset_step(
+            &mut self.sub,
+            &mut Access::Own(p),
+            self.tol,
+            t,
+            h,
+            ring,
+            &changed,
+            floor,
+            &at,
+        ) {
+            Ok(_) => {}
             // The ring swimmers and outsiders of contacts forming across the ring's edge.
-            return crossing
-                .into_iter()
-                .filter(|b| refined.binary_search(b).is_err())
-                .collect();
+            Err(Refusal::Crossing(crossing)) => {
+                return crossing
+                    .into_iter()
+                    .filter(|b| refined.binary_search(b).is_err())
+                    .collect()
+            }
+            Err(_) => return ring.to_vec(),
         }
         let missed: Vec<usize> = ring
             .iter()
@@ -541,6 +792,20 @@ impl Suspension {
         }
         missed
     }
+}
+
+/// A refined path's states at time `tau` from the coarse step's start: linear between its steps.
+fn path_at(path: &Path, tau: f64) -> impl Iterator<Item = f64> + '_ {
+    let j = path
+        .partition_point(|(s, _)| *s <= tau)
+        .clamp(1, path.len() - 1);
+    let ((s0, a), (s1, b)) = (&path[j - 1], &path[j]);
+    let w = if s1 > s0 {
+        ((tau - s0) / (s1 - s0)).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    a.iter().zip(b).map(move |(a, b)| a + w * (b - a))
 }
 
 /// Stage `i`'s argument y0 + Σ_j A_ij k_j and the Γ-combination Σ_j Γ_ij k_j of the earlier

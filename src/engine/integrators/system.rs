@@ -101,7 +101,7 @@ pub trait OdeSystem {
 /// A system of bodies (swimmers) with [`Partitioned::body_size`] state components each, that a
 /// multirate method steps body by body: some bodies take shorter steps than others, reading the
 /// states of the rest from an interpolation.
-pub trait Partitioned {
+pub trait Partitioned: Sync {
     /// State components per body (the state is the bodies' blocks one after another).
     fn body_size(&self) -> usize;
     /// Each body's error of a step from `y` to `y_new` (embedded estimate `err`, step `h`, rates
@@ -140,11 +140,39 @@ pub trait Partitioned {
     /// `bodies` to one outside (a contact forming with a body stepped apart), the bodies of every
     /// such coupling, both ends, sorted.
     fn stiff_groups_of(
-        &mut self,
+        &self,
         t: f64,
         y: &[f64],
         bodies: &[usize],
     ) -> Result<GroupJacobian, Vec<usize>>;
+    /// Whether [`Partitioned::rates_shared`] can answer (else it always refuses).
+    fn shares_rates(&self) -> bool {
+        false
+    }
+    /// The rates of `bodies` at `y` into their blocks of `dy`, as [`Partitioned::rhs_bodies`]
+    /// gives them, without changing the system (so on several threads at once): false, with
+    /// `dy` untouched, when the states of `changed` need the system updated first.
+    fn rates_shared(&self, y: &[f64], bodies: &[usize], changed: &[usize], dy: &mut [f64]) -> bool {
+        let _ = (y, bodies, changed, dy);
+        false
+    }
+    /// How much reading the bodies `sources` (sorted) at their states in `after` instead of
+    /// `before` changes the rates of `bodies`, each taken at its state in `before`: h times that
+    /// change as an error of a step of `h` ([`Partitioned::body_errors`]'s measure, with its
+    /// `floor` and the rates `f0` at the step's start), into `out` (indexed by body).
+    #[allow(clippy::too_many_arguments)]
+    fn read_errors(
+        &self,
+        before: &[f64],
+        after: &[f64],
+        bodies: &[usize],
+        sources: &[usize],
+        h: f64,
+        f0: &[f64],
+        tol: f64,
+        floor: &[f64],
+        out: &mut [f64],
+    );
 }
 
 /// A block-sparse matrix: a dense square block on each of several disjoint groups of state
