@@ -109,3 +109,27 @@ fn history_survives_a_killed_terminal() {
     assert!(text.contains("let kept = 41;"), "{text}");
     assert!(text.contains("kept + 1"), "{text}");
 }
+
+// An empty SWIMLAB_HISTORY or XDG_DATA_HOME counts as unset (the XDG base directory rules): the
+// history goes to $HOME/.local/share/swimlab/history, as with neither set.
+#[test]
+fn empty_history_variables_count_as_unset() {
+    let home = std::env::temp_dir().join(format!("swimlab-pty-home-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&home);
+    std::fs::create_dir_all(&home).unwrap();
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_swimlab"));
+    cmd.env("SWIMLAB_HISTORY", "")
+        .env("XDG_DATA_HOME", "")
+        .env("HOME", &home)
+        .env("TERM", "xterm");
+    let mut s = Session::spawn(cmd).expect("spawn swimlab in a pty");
+    s.set_expect_timeout(Some(Duration::from_secs(20)));
+    s.expect(PROMPT).unwrap();
+    step(&mut s, "let typed = 7;", "");
+    s.send(ControlCode::EndOfTransmission).unwrap();
+    s.expect(Eof).unwrap();
+    let hist = home.join(".local/share/swimlab/history");
+    let text = std::fs::read_to_string(&hist).expect("the history file under HOME");
+    assert!(text.contains("let typed = 7;"), "{text}");
+    let _ = std::fs::remove_dir_all(&home);
+}

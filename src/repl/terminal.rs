@@ -15,14 +15,14 @@ use std::rc::Rc;
 pub const PROMPT: &str = "swimlab> ";
 
 /// Where history is kept: $SWIMLAB_HISTORY, else $XDG_DATA_HOME/swimlab/history, else
-/// ~/.local/share/swimlab/history.
+/// ~/.local/share/swimlab/history (empty variables count as unset, a relative XDG_DATA_HOME as
+/// invalid: the XDG rules).
 pub fn history_path() -> Option<PathBuf> {
-    if let Some(p) = std::env::var_os("SWIMLAB_HISTORY") {
-        return Some(PathBuf::from(p));
+    if let Some(p) = super::env_path("SWIMLAB_HISTORY", false) {
+        return Some(p);
     }
-    let data = std::env::var_os("XDG_DATA_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")))?;
+    let data = super::env_path("XDG_DATA_HOME", true)
+        .or_else(|| super::env_path("HOME", false).map(|h| h.join(".local/share")))?;
     Some(data.join("swimlab").join("history"))
 }
 

@@ -15,17 +15,15 @@ fn data_dir(target: &Target) -> Result<PathBuf, String> {
     match target {
         Target::Prefix(p) => Ok(p.join("share").join("jupyter")),
         Target::User => {
-            if let Some(d) = std::env::var_os("JUPYTER_DATA_DIR") {
-                return Ok(PathBuf::from(d));
+            if let Some(d) = crate::repl::env_path("JUPYTER_DATA_DIR", false) {
+                return Ok(d);
             }
-            let home = std::env::var_os("HOME")
-                .map(PathBuf::from)
-                .ok_or("HOME is not set; give --prefix DIR")?;
+            let home = crate::repl::env_path("HOME", false)
+                .ok_or("HOME is not set (or empty); give --prefix DIR")?;
             if cfg!(target_os = "macos") {
                 Ok(home.join("Library").join("Jupyter"))
             } else {
-                let data = std::env::var_os("XDG_DATA_HOME")
-                    .map(PathBuf::from)
+                let data = crate::repl::env_path("XDG_DATA_HOME", true)
                     .unwrap_or_else(|| home.join(".local").join("share"));
                 Ok(data.join("jupyter"))
             }
