@@ -175,3 +175,50 @@ fn a_failed_redeclaration_keeps_the_old_variable() {
     );
     assert_eq!(out(&mut s, "sc.count"), "=> 2");
 }
+
+// `ans` is the last value an input gave, shown or not (as in Julia); a constant `ans` of the
+// user's stays.
+#[test]
+fn ans_is_the_last_value() {
+    let mut s = Session::new();
+    assert_eq!(out(&mut s, "1 + 2"), "=> 3");
+    assert_eq!(out(&mut s, "ans * 10"), "=> 30");
+    assert_eq!(out(&mut s, "ans + 1;"), "", "a trailing ; hides the value");
+    assert_eq!(out(&mut s, "ans"), "=> 31");
+    assert_eq!(out(&mut s, "let x = 5;"), "", "a statement gives no value");
+    assert_eq!(out(&mut s, "ans"), "=> 31");
+    assert!(matches!(s.handle("undefined_name + 1"), Reply::Error(_)));
+    assert_eq!(out(&mut s, "ans"), "=> 31", "a failed input leaves ans");
+    out(&mut s, "const ans = 7;");
+    assert_eq!(out(&mut s, "40 + 2"), "=> 42");
+    assert_eq!(out(&mut s, "ans"), "=> 7");
+}
+
+// `:time CODE` answers as CODE does, then with its wall time and, for each scene that ran, the
+// steps and right-hand sides it took; `:history [N]` lists the session's inputs.
+#[test]
+fn time_and_history_commands() {
+    let mut s = Session::new();
+    assert_eq!(out(&mut s, "let sc = scene(); sc.add(dumbbell());"), "");
+    let timed = out(
+        &mut s,
+        ":time sc.integrator = rk4(1e-5); sc.run(0.001); sc.count",
+    );
+    let lines: Vec<&str> = timed.lines().collect();
+    assert_eq!(lines[0], "=> 1", "{timed}");
+    assert!(lines[1].starts_with("time: "), "{timed}");
+    assert_eq!(lines[2], "sc: 100 steps, 400 right-hand sides", "{timed}");
+    assert_eq!(out(&mut s, ":time 1 + 1").lines().count(), 2);
+    match s.handle(":time") {
+        Reply::Error(e) => assert!(e.contains(":time s.run_periods(100)"), "{e}"),
+        other => panic!("{other:?}"),
+    }
+    let all = out(&mut s, ":history");
+    assert!(all.starts_with("   1  let sc = scene();"), "{all}");
+    assert!(all.contains("   2  :time sc.integrator"), "{all}");
+    assert_eq!(out(&mut s, ":history 1"), "   4  :time");
+    match s.handle(":history x") {
+        Reply::Error(e) => assert!(e.contains(":history 10"), "{e}"),
+        other => panic!("{other:?}"),
+    }
+}

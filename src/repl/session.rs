@@ -24,8 +24,24 @@ pub struct Session {
     scope: Scope<'static>,
     functions: AST,
     inputs: usize,
+    /// The inputs handled so far (`:history`).
+    history: Vec<String>,
     /// Completion's registered names, made on first use.
     names: std::sync::OnceLock<Vec<String>>,
+}
+
+/// A wall time in words: µs, ms or s to a thousandth, minutes and seconds from a minute on.
+fn duration_in_words(seconds: f64) -> String {
+    if seconds < 1e-3 {
+        format!("{:.3} µs", seconds * 1e6)
+    } else if seconds < 1.0 {
+        format!("{:.3} ms", seconds * 1e3)
+    } else if seconds < 60.0 {
+        format!("{seconds:.3} s")
+    } else {
+        let m = (seconds / 60.0).floor();
+        format!("{m:.0} min {:.1} s", seconds - 60.0 * m)
+    }
 }
 
 /// Keywords offered by completion.
@@ -50,6 +66,14 @@ const COMMANDS: &[(&str, &str)] = &[
         "run a script file in this session (its variables and functions stay)",
     ),
     (":vars", "list the variables in scope"),
+    (
+        ":time CODE",
+        "run CODE and say how long it took (and the steps and right-hand sides of each scene that ran)",
+    ),
+    (
+        ":history [N]",
+        "list this session's inputs (the last N)",
+    ),
     (":clear", "forget all variables and functions"),
     (":quit", "leave (Ctrl-D does too)"),
 ];
@@ -64,6 +88,7 @@ impl Session {
             scope: Scope::new(),
             functions: AST::empty(),
             inputs: 0,
+            history: Vec::new(),
             names: std::sync::OnceLock::new(),
         }
     }
@@ -87,6 +112,9 @@ impl Session {
         let t = input.trim();
         if t.is_empty() {
             return Reply::Output(String::new());
+        }
+        if !t.starts_with(":history") {
+            self.history.push(t.to_string());
         }
         if let Some(cmd) = t.strip_prefix(':') {
             return self.command(cmd);
@@ -141,6 +169,12 @@ impl Session {
         if result.is_ok() {
             self.keep_imports(source);
         }
+        // As in Julia, `ans` is the last value an input gave, shown or not.
+        if let Ok(v) = &result {
+            if !v.is_unit() {
+                self.set_ans(v.clone());
+            }
+        }
         // As in IPython and Julia, a trailing `;` means "don't show the value".
         let quiet = source.trim_end().ends_with(';');
         match result {
@@ -148,6 +182,74 @@ impl Session {
             Ok(v) => Ok(Some(v)),
             Err(e) => Err(render_error(name, source, &e)),
         }
+    }
+
+    /// `ans` set to `v`, unless the user made `ans` a constant.
+    fn set_ans(&mut self, v: Dynamic) {
+        if self.scope.is_constant("ans") == Some(true) {
+            return;
+        }
+        let _ = self.scope.remove::<Dynamic>("ans");
+        self.scope.push_dynamic("ans", v);
+    }
+
+    /// Each scene in scope by name, with its steps and right-hand sides so far.
+    fn scene_stats(&self) -> Vec<(String, (u64, u64))> {
+        self.scope
+            .iter_raw()
+            .filter_map(|(name, _, value)| {
+                let h = value.read_lock::<script::SceneHandle>()?;
+                let stats = h.borrow().scene().stats();
+                Some((name.to_string(), (stats.steps, stats.rhs_evals)))
+            })
+            .collect()
+    }
+
+    /// `:time CODE`: the reply to CODE, then its wall time and what each scene that ran took.
+    fn timed(&mut self, code: &str) -> Reply {
+        let before = self.scene_stats();
+        let start = std::time::Instant::now();
+        let name = self.next_name();
+        let reply = self.eval(&name, code);
+        let elapsed = start.elapsed().as_secs_f64();
+        let mut lines = vec![format!("time: {}", duration_in_words(elapsed))];
+        for (scene, after) in self.scene_stats() {
+            let Some((_, b)) = before.iter().find(|(n, _)| *n == scene) else {
+                continue;
+            };
+            let (steps, rhs) = (after.0.saturating_sub(b.0), after.1.saturating_sub(b.1));
+            if steps > 0 || rhs > 0 {
+                lines.push(format!("{scene}: {steps} steps, {rhs} right-hand sides"));
+            }
+        }
+        let timing = lines.join("\n");
+        match reply {
+            Reply::Output(o) if o.is_empty() => Reply::Output(timing),
+            Reply::Output(o) => Reply::Output(format!("{o}\n{timing}")),
+            Reply::Error(e) => Reply::Error(format!("{e}\n{timing}")),
+            Reply::Quit => Reply::Quit,
+        }
+    }
+
+    /// `:history [N]`: this session's inputs, numbered, the last `n` of them (all when `None`).
+    fn history_listing(&self, n: Option<usize>) -> String {
+        if self.history.is_empty() {
+            return "(no inputs yet)".into();
+        }
+        let from = n.map_or(0, |n| self.history.len().saturating_sub(n));
+        self.history[from..]
+            .iter()
+            .enumerate()
+            .map(|(k, input)| {
+                let mut lines = input.lines();
+                let first = format!("{:>4}  {}", from + k + 1, lines.next().unwrap_or(""));
+                std::iter::once(first)
+                    .chain(lines.map(|l| format!("      {l}")))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
     }
 
     /// The variables `ast` declares anew at its top level before anything in it mentions them (a
@@ -253,6 +355,19 @@ impl Session {
                 }
                 Reply::Output(out.join("\n"))
             }
+            "time" if arg.is_empty() => {
+                Reply::Error(":time needs code to run: :time s.run_periods(100)".into())
+            }
+            "time" => self.timed(arg),
+            "history" => match arg {
+                "" => Reply::Output(self.history_listing(None)),
+                n => match n.parse::<usize>() {
+                    Ok(n) => Reply::Output(self.history_listing(Some(n))),
+                    Err(_) => Reply::Error(format!(
+                        ":history takes a count of inputs, got \"{n}\": :history 10"
+                    )),
+                },
+            },
             "clear" => {
                 self.scope.clear();
                 self.functions = AST::empty();
