@@ -142,6 +142,8 @@ fn script_types_are_named_in_words() {
     );
     let lines: Vec<&str> = shown.lines().collect();
     assert!(lines[0].starts_with("Field(density, grid"), "{shown}");
+    // The pair's density integrates to its two swimmers (to the kernel's truncation).
+    assert!(lines[0].ends_with("integral 2.0000)"), "{shown}");
     assert_eq!(lines[0], lines[1], "display and print agree: {shown}");
     assert!(
         lines[2].starts_with("euler(") && lines[4].contains("every 2 periods"),

@@ -202,14 +202,20 @@ impl std::fmt::Display for Field {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "Field({}, grid {:?}, cells {:.3e} x {:.3e} x {:.3e} m, width {:.3e} m{})",
+            "Field({}, grid {:?}, cells {:.3e} x {:.3e} x {:.3e} m, width {:.3e} m{}, {})",
             self.kind.name(),
             self.grid,
             self.spacing[0],
             self.spacing[1],
             self.spacing[2],
             self.width,
-            if self.periodic { ", periodic" } else { "" }
+            if self.periodic { ", periodic" } else { "" },
+            // What the values add up to: the swimmers a density holds; the cells' mean |Π| or
+            // largest Q eigenvalue otherwise.
+            match self.kind {
+                FieldKind::Density => format!("integral {:.4}", self.integral()),
+                _ => format!("cell mean {:.4e}", self.stat(FieldStat::Mean)),
+            }
         )
     }
 }
