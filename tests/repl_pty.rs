@@ -46,6 +46,13 @@ fn transcript_of_a_session() {
     s.send("let s = sce\t").unwrap();
     step(&mut s, "();", "");
     step(&mut s, "s.count", "=> 0");
+    // A second Tab lists the candidates (the first completes what they share), the value's own.
+    s.send("s.ru\t\t").unwrap();
+    s.expect(expectrl::Regex("run +run_periods"))
+        .expect("a second Tab lists the candidates");
+    // Ctrl-U clears the line.
+    s.send("\x15").unwrap();
+    step(&mut s, "40 + 2", "=> 42");
     step(&mut s, ":help rk4", "Classic Runge-Kutta 4");
     // An error keeps the session.
     step(&mut s, "s.model = \"fast\";", "unknown model");

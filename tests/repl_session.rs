@@ -222,3 +222,30 @@ fn time_and_history_commands() {
         other => panic!("{other:?}"),
     }
 }
+
+// Completion after `value.` offers that value's own methods and properties when its type is
+// known (a Field's `to_vtk`, not a Scene's), and every name otherwise.
+#[test]
+fn completion_after_a_dot_follows_the_value_type() {
+    let mut s = Session::new();
+    out(
+        &mut s,
+        "let sc = scene(); sc.box = [1e-4, 1e-4, 1e-4]; sc.add(dumbbell()); let f = sc.field(\"density\");",
+    );
+    let names = |s: &Session, line: &str| s.complete(line, line.len()).1;
+    assert_eq!(names(&s, "f.to_v"), vec!["to_vtk"]);
+    assert!(
+        names(&s, "sc.to_v").is_empty(),
+        "{:?}",
+        names(&s, "sc.to_v")
+    );
+    let runs = names(&s, "sc.ru");
+    assert!(
+        runs.contains(&"run".to_string()) && runs.contains(&"run_periods".to_string()),
+        "{runs:?}"
+    );
+    assert!(names(&s, "sc.").contains(&"count".to_string()));
+    assert!(!names(&s, "sc.").contains(&"to_vtk".to_string()));
+    // An unknown receiver: every name.
+    assert!(names(&s, "nothing.to_v").contains(&"to_vtk".to_string()));
+}

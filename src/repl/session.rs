@@ -28,6 +28,8 @@ pub struct Session {
     history: Vec<String>,
     /// Completion's registered names, made on first use.
     names: std::sync::OnceLock<Vec<String>>,
+    /// The registered methods and properties of each script type, made on first use.
+    methods: std::sync::OnceLock<std::collections::HashMap<String, Vec<String>>>,
 }
 
 /// A wall time in words: µs, ms or s to a thousandth, minutes and seconds from a minute on.
@@ -90,6 +92,7 @@ impl Session {
             inputs: 0,
             history: Vec::new(),
             names: std::sync::OnceLock::new(),
+            methods: std::sync::OnceLock::new(),
         }
     }
 
@@ -466,7 +469,10 @@ impl Session {
                 .map(|(c, _)| c.split_whitespace().next().unwrap_or(c).to_string())
                 .collect()
         } else if after_dot {
-            self.names().to_vec()
+            // After `value.`, that value's methods and properties when its type is known.
+            self.receiver_type(&head[..start - 1])
+                .and_then(|ty| self.methods().get(&ty).cloned())
+                .unwrap_or_else(|| self.names().to_vec())
         } else {
             self.names()
                 .iter()
@@ -480,6 +486,52 @@ impl Session {
         out.sort();
         out.dedup();
         (start, out)
+    }
+
+    /// The script type of the variable that `before` (the text up to a `.`) ends with.
+    fn receiver_type(&self, before: &str) -> Option<String> {
+        let start = before
+            .char_indices()
+            .rev()
+            .find(|(_, c)| !(c.is_alphanumeric() || *c == '_'))
+            .map_or(0, |(i, c)| i + c.len_utf8());
+        let name = &before[start..];
+        let value = self.scope.get(name)?;
+        Some(script::type_word(value))
+    }
+
+    /// Each script type's registered methods and properties (by the type of their first
+    /// parameter), sorted (computed once).
+    fn methods(&self) -> &std::collections::HashMap<String, Vec<String>> {
+        self.methods.get_or_init(|| {
+            let mut by_type: std::collections::HashMap<String, Vec<String>> = Default::default();
+            for sig in self.engine.gen_fn_signatures(false) {
+                let Some((name, rest)) = sig.split_once('(') else {
+                    continue;
+                };
+                let name = name.trim_start_matches("get$").trim_start_matches("set$");
+                let first = rest.split([',', ')']).next().unwrap_or("");
+                let Some((_, ty)) = first.split_once(": ") else {
+                    continue;
+                };
+                let ty = ty.trim().trim_start_matches("&mut ").trim();
+                if name
+                    .chars()
+                    .next()
+                    .is_some_and(|c| c.is_alphabetic() || c == '_')
+                {
+                    by_type
+                        .entry(ty.to_string())
+                        .or_default()
+                        .push(name.to_string());
+                }
+            }
+            for names in by_type.values_mut() {
+                names.sort();
+                names.dedup();
+            }
+            by_type
+        })
     }
 
     /// The registered and documented names, sorted (computed once).

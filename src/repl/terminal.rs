@@ -5,7 +5,7 @@ use super::session::{Reply, Session};
 use crate::script::interrupt;
 use rustyline::error::ReadlineError;
 use rustyline::history::DefaultHistory;
-use rustyline::{Config, Editor};
+use rustyline::{CompletionType, Config, Editor};
 use std::cell::RefCell;
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::PathBuf;
@@ -53,7 +53,12 @@ fn append_history(rl: &mut Editor<ReplHelper, DefaultHistory>, path: &std::path:
 
 fn interactive() -> bool {
     let session = Rc::new(RefCell::new(Session::new()));
-    let config = Config::builder().auto_add_history(false).build();
+    // A first Tab completes what the candidates share, a second lists them (as bash and
+    // IPython do).
+    let config = Config::builder()
+        .auto_add_history(false)
+        .completion_type(CompletionType::List)
+        .build();
     let mut rl: Editor<ReplHelper, DefaultHistory> = match Editor::with_config(config) {
         Ok(rl) => rl,
         Err(e) => {

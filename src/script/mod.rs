@@ -49,4 +49,5 @@ pub use picture_api::Picture;
 pub use render::render_error;
 pub use scene_api::SceneHandle;
 pub use show::show;
+pub use types::type_word;
 pub use util_api::quick;
