@@ -145,17 +145,6 @@ impl AveragedSystem {
         self.listed.list.as_ref()
     }
 
-    /// The neighbour list and its slot arrays. Only called with lists in use after `fill` and
-    /// `update_list`, which builds a list whenever lists are in use: never without one.
-    pub(super) fn listed_parts(&self) -> (&NeighbourList, &Soa) {
-        let list = self
-            .listed
-            .list
-            .as_ref()
-            .expect("update_list builds a list whenever lists are in use");
-        (list, &self.listed.slots)
-    }
-
     /// Swimmer `s`'s slot entries (its slot and ghosts) from its centre `c` and orientation `n`.
     pub(super) fn refresh_slots(&mut self, s: usize, c: [f64; 3], n: [f64; 3]) {
         let Some(list) = &self.listed.list else {

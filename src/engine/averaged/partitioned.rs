@@ -6,6 +6,7 @@
 
 use super::{vec3, AveragedSystem, STATE_PER_SWIMMER};
 use crate::engine::integrators::{GroupJacobian, Partitioned};
+use crate::engine::neighbours::NeighbourList;
 use crate::engine::periodic::separation;
 use nalgebra::Vector3;
 
@@ -96,14 +97,15 @@ impl Partitioned for AveragedSystem {
                 );
             }
         }
-        if self.uses_lists() {
-            self.listed_rates(y, bodies, dy);
-        } else {
-            let vector = self.vector_rows();
-            let mut out = [0.0; STATE_PER_SWIMMER];
-            for &s in bodies {
-                self.row_rates(s, y, vector, &mut out);
-                dy[STATE_PER_SWIMMER * s..STATE_PER_SWIMMER * (s + 1)].copy_from_slice(&out);
+        match self.listed_list().filter(|_| self.uses_lists()) {
+            Some(list) => self.listed_rates(list, y, bodies, dy),
+            None => {
+                let vector = self.vector_rows();
+                let mut out = [0.0; STATE_PER_SWIMMER];
+                for &s in bodies {
+                    self.row_rates(s, y, vector, &mut out);
+                    dy[STATE_PER_SWIMMER * s..STATE_PER_SWIMMER * (s + 1)].copy_from_slice(&out);
+                }
             }
         }
     }
@@ -137,10 +139,13 @@ impl Partitioned for AveragedSystem {
     }
 
     fn rates_shared(&self, y: &[f64], bodies: &[usize], changed: &[usize], dy: &mut [f64]) -> bool {
-        if !self.shares_rates() || !changed.iter().all(|&s| self.holds(y, s)) {
+        let Some(list) = self.listed_list().filter(|_| self.uses_lists()) else {
+            return false;
+        };
+        if !changed.iter().all(|&s| self.holds(y, s)) {
             return false;
         }
-        self.listed_rates(y, bodies, dy);
+        self.listed_rates(list, y, bodies, dy);
         true
     }
 
@@ -159,24 +164,9 @@ impl Partitioned for AveragedSystem {
         let periodic = self.periodic.as_ref();
         let mut partners = Vec::new();
         for &s in bodies {
-            // The sources among s's partners: through its list rows, or all of them.
-            partners.clear();
-            match self.listed_list() {
-                Some(list) => {
-                    let k = list.slot_of[s] as usize;
-                    for &q in list.far_row(k).0.iter().chain(list.near_row(k)) {
-                        if q as usize != list.pad_slot() {
-                            let r = list.swimmer_of(q as usize);
-                            if sources.binary_search(&r).is_ok() {
-                                partners.push(r);
-                            }
-                        }
-                    }
-                    partners.sort_unstable();
-                    partners.dedup();
-                }
-                None => partners.extend(sources.iter().filter(|&&r| r != s)),
-            }
+            // The sources among s's partners.
+            self.partners(&[s], &mut partners);
+            partners.retain(|r| sources.binary_search(r).is_ok());
             let cs = self.center(before, s);
             let ns = vec3(before, STATE_PER_SWIMMER * s + 3);
             let (mut dv, mut dt) = (Vector3::zeros(), Vector3::zeros());
@@ -210,22 +200,21 @@ impl AveragedSystem {
             .is_some_and(|list| list.holds(s, c.x, c.y, c.z))
     }
 
-    /// The rates of `bodies` at state `y` into their blocks of `dy`
-    /// ([`AveragedSystem::rates_from_state`]).
-    fn listed_rates(&self, y: &[f64], bodies: &[usize], dy: &mut [f64]) {
+    /// The rates of `bodies` at state `y` into their blocks of `dy`, through `list` (the one in
+    /// use; [`AveragedSystem::rates_from_state`]).
+    fn listed_rates(&self, list: &NeighbourList, y: &[f64], bodies: &[usize], dy: &mut [f64]) {
         let mut out = [0.0; STATE_PER_SWIMMER];
         for &s in bodies {
-            self.rates_from_state(y, s, &mut out);
+            self.rates_from_state(list, y, s, &mut out);
             dy[STATE_PER_SWIMMER * s..STATE_PER_SWIMMER * (s + 1)].copy_from_slice(&out);
         }
     }
 
-    /// Swimmer `s`'s rates at state `y` (after `update_list`), its partners found through its list
-    /// rows and read from `y`, met at their minimum images (the list's images within its radius):
+    /// Swimmer `s`'s rates at state `y` (after `update_list`), its partners found through its rows
+    /// in `list` and read from `y`, met at their minimum images (the list's images within its radius):
     /// the far field of [`AveragedSystem::add_pair_terms`] over the far row with its weights,
     /// the steric forces over the near row.
-    fn rates_from_state(&self, y: &[f64], s: usize, out: &mut [f64]) {
-        let (list, _) = self.listed_parts();
+    fn rates_from_state(&self, list: &NeighbourList, y: &[f64], s: usize, out: &mut [f64]) {
         let periodic = self.periodic.as_ref();
         let k = list.slot_of[s] as usize;
         let pad = list.pad_slot();

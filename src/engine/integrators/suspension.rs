@@ -630,9 +630,10 @@ impl Suspension {
                     path,
                     steps: taken,
                 }) => {
-                    let end = &path.last().expect("a path holds its start").1;
-                    for (&m, &v) in comps.iter().zip(end) {
-                        self.y_new[m] = v;
+                    if let Some((_, end)) = path.last() {
+                        for (&m, &v) in comps.iter().zip(end) {
+                            self.y_new[m] = v;
+                        }
                     }
                     self.paths.push((comps, path));
                     steps += taken;
