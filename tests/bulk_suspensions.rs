@@ -356,3 +356,64 @@ fn refinement_does_not_depend_on_the_thread_count() {
     assert!(refined > 0, "nothing was refined");
     assert_eq!(run_on(2), (one, refined));
 }
+
+// A relisting that meets new partners across a face adds ghost slots; the slot arrays filled
+// before it then get only those ghosts' entries appended (`extend_positions`,
+// `extend_values`), which must equal arrays filled anew after it, bit for bit (the same
+// additions of the same lattice vectors).
+#[test]
+fn slot_arrays_extended_after_a_relisting_equal_arrays_filled_anew() {
+    use swimlab::engine::neighbours::{ListSpec, NeighbourList};
+    use swimlab::engine::periodic::PeriodicBox;
+    let side = 20.0;
+    let b = PeriodicBox::new([side; 3]).unwrap();
+    // 500 centres on a jittered lattice (the box spans −L/2..L/2 after wrapping), swimmer 0
+    // near the middle of the box.
+    let n = 500;
+    let mut x: Vec<f64> = (0..n)
+        .map(|i| (i % 8) as f64 * 2.5 + 0.1 * (i % 3) as f64)
+        .collect();
+    let mut y: Vec<f64> = (0..n)
+        .map(|i| ((i / 8) % 8) as f64 * 2.5 + 0.07 * (i % 5) as f64)
+        .collect();
+    let mut z: Vec<f64> = (0..n)
+        .map(|i| (i / 64) as f64 * 2.5 + 0.05 * (i % 7) as f64)
+        .collect();
+    (x[0], y[0], z[0]) = (1.2, 1.2, 1.2);
+    let spec = ListSpec {
+        cutoff: 3.0,
+        contact_reach: 1.0,
+        skin: 0.5,
+    };
+    let weight = |i: usize, j: usize| Some(((i * 31 + j * 17) % 11) as f64 / 11.0 - 0.5);
+    let mut list = NeighbourList::build(&x, &y, &z, Some(&b), spec, &weight);
+    let (mut px, mut py, mut pz) = (Vec::new(), Vec::new(), Vec::new());
+    list.fill_positions([&x, &y, &z], [&mut px, &mut py, &mut pz]);
+    let mut ids = Vec::new();
+    list.fill_values(|s| s as f64, -1.0, &mut ids);
+    let slots_before = list.slots();
+    // Swimmer 0 jumps to a corner of the box: it meets its new partners across three faces.
+    (x[0], y[0], z[0]) = (9.9, 9.9, 9.9);
+    let grown = list.relist(0, [x[0], y[0], z[0]], &weight);
+    assert!(grown && list.slots() > slots_before, "no ghost slot added");
+    // The new ghosts appended, then the moved swimmer's entries set (its slot and ghosts), as
+    // the averaged system does after a relisting.
+    list.extend_positions([&mut px, &mut py, &mut pz]);
+    list.extend_values(&mut ids);
+    list.set_position(
+        0,
+        [x[0], y[0], z[0]],
+        [&mut px[..], &mut py[..], &mut pz[..]],
+    );
+    let (mut qx, mut qy, mut qz) = (Vec::new(), Vec::new(), Vec::new());
+    list.fill_positions([&x, &y, &z], [&mut qx, &mut qy, &mut qz]);
+    let mut fresh = Vec::new();
+    list.fill_values(|s| s as f64, -1.0, &mut fresh);
+    assert_eq!(px.len(), list.slots());
+    for (d, (a, b)) in [(&px, &qx), (&py, &qy), (&pz, &qz)].into_iter().enumerate() {
+        for k in 0..a.len() {
+            assert_eq!(a[k].to_bits(), b[k].to_bits(), "axis {d}, slot {k}");
+        }
+    }
+    assert_eq!(ids, fresh);
+}

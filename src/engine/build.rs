@@ -132,10 +132,9 @@ pub fn random_suspension_apart(
         .iter()
         .flat_map(|o| [o.a1, o.a2])
         .fold(d.a1.max(d.a2), f64::max);
-    // The spheres placed so far: centres and radii, binned by centre.
+    // The spheres placed so far: radii, binned by centre.
     let mut spheres = Spheres {
         cells: CellMap::new(2.0 * a_max + margin, scene.periodic()),
-        centres: Vec::new(),
         radii: Vec::new(),
     };
     for i in 0..scene.count() {
@@ -170,9 +169,9 @@ pub fn random_suspension_apart(
         let new = Dumbbell { phase, ..d };
         let (x1, x2) = new.sphere_positions(c, dir, scene.contact_length(&new));
         let clear = [(x1, d.a1), (x2, d.a2)].iter().all(|&(x, a)| {
-            spheres.cells.near(x.x, x.y, x.z, |k| {
+            spheres.cells.near(x.x, x.y, x.z, |k, at| {
                 let k = k as usize;
-                let gap = separation(periodic.as_ref(), x - spheres.centres[k]).norm()
+                let gap = separation(periodic.as_ref(), x - Vector3::from(at)).norm()
                     - a
                     - spheres.radii[k];
                 gap > margin
@@ -188,17 +187,16 @@ pub fn random_suspension_apart(
     Ok(())
 }
 
-/// Placed spheres for [`random_suspension_apart`]: centres and radii, binned by centre.
+/// Placed spheres for [`random_suspension_apart`]: binned by centre (the cells keep the
+/// centres), with their radii.
 struct Spheres {
     cells: CellMap,
-    centres: Vec<Vector3<f64>>,
     radii: Vec<f64>,
 }
 
 impl Spheres {
     fn insert(&mut self, x: Vector3<f64>, a: f64) {
         self.cells.insert(x.x, x.y, x.z, self.radii.len() as u32);
-        self.centres.push(x);
         self.radii.push(a);
     }
 }

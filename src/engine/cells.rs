@@ -132,11 +132,14 @@ impl CellGrid {
 }
 
 /// Points binned into cells as they come, for a set that grows while it is searched (random
-/// placement): the points within `size` of a point are among those [`CellMap::near`] visits.
+/// placement, relisting): the points within `size` of a point are among those [`CellMap::near`]
+/// visits. Each cell keeps its points' positions beside their ids, so a search reads each cell
+/// as one contiguous run (the points' own arrays, read by id, would miss the caches in a large
+/// scene).
 #[derive(Debug, Clone, Default)]
 pub struct CellMap {
     binning: Binning,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    cells: HashMap<[i64; 3], Vec<(u32, [f64; 3])>>,
 }
 
 impl CellMap {
@@ -151,25 +154,31 @@ impl CellMap {
     /// Add point `id` at (x, y, z).
     pub fn insert(&mut self, x: f64, y: f64, z: f64, id: u32) {
         let key = self.binning.key(x, y, z);
-        self.cells.entry(key).or_default().push(id);
+        self.cells.entry(key).or_default().push((id, [x, y, z]));
     }
 
     /// Take point `id` at (x, y, z) out (where it was inserted).
     pub fn remove(&mut self, x: f64, y: f64, z: f64, id: u32) {
         let key = self.binning.key(x, y, z);
         if let Some(ids) = self.cells.get_mut(&key) {
-            ids.retain(|&i| i != id);
+            ids.retain(|p| p.0 != id);
         }
     }
 
-    /// Call `visit` with every point in the 27 cells around (x, y, z), each once, until it
-    /// returns false; returns whether it never did.
-    pub fn near(&self, x: f64, y: f64, z: f64, mut visit: impl FnMut(u32) -> bool) -> bool {
+    /// Call `visit` with every point (its id and where it was inserted) in the 27 cells around
+    /// (x, y, z), each once, until it returns false; returns whether it never did.
+    pub fn near(
+        &self,
+        x: f64,
+        y: f64,
+        z: f64,
+        mut visit: impl FnMut(u32, [f64; 3]) -> bool,
+    ) -> bool {
         let mut go_on = true;
         self.binning.around(self.binning.key(x, y, z), |cell| {
             if go_on {
                 if let Some(ids) = self.cells.get(&cell) {
-                    go_on = ids.iter().all(|&id| visit(id));
+                    go_on = ids.iter().all(|&(id, p)| visit(id, p));
                 }
             }
         });

@@ -184,7 +184,7 @@ impl NeighbourList {
         let with_near = self.spec.contact_reach > 0.0;
         let p = [0, 1, 2].map(|d| self.reference(s, d));
         let mut found: Vec<Found> = Vec::new();
-        self.cells.near(p[0], p[1], p[2], |j| {
+        self.cells.near(p[0], p[1], p[2], |j, q| {
             let j = j as usize;
             if j == s {
                 return true;
@@ -192,7 +192,8 @@ impl NeighbourList {
             let mut image = [0i8; 3];
             let mut d2 = 0.0;
             for (d, m) in image.iter_mut().enumerate() {
-                let mut x = p[d] - self.reference(j, d);
+                // q is j's reference slot position, as inserted.
+                let mut x = p[d] - q[d];
                 if let Some(l) = self.sides {
                     let steps = nearest_integer(x / l[d]);
                     *m = steps as i8;
@@ -255,7 +256,8 @@ impl NeighbourList {
 
     /// Relist swimmer `s`, now at `c` (unwrapped): its reference set there, its entries taken out
     /// of its old partners' rows, its row found anew, and itself entered in its new partners'
-    /// rows. Returns whether ghost slots were added (the slot arrays then need refilling).
+    /// rows. Returns whether ghost slots were added (the slot arrays then lack their entries:
+    /// [`NeighbourList::extend_positions`], [`NeighbourList::extend_values`]).
     pub fn relist(&mut self, s: usize, c: [f64; 3], weight: Weight) -> bool {
         let ghosts_before = self.ghosts.len();
         let k = self.slot_of[s] as usize;
@@ -381,15 +383,25 @@ impl NeighbourList {
 
     /// Fill `out` (each resized to [`NeighbourList::slots`]) with the slot positions of the centres
     /// `x`, `y`, `z` (unwrapped, swimmer order): swimmers, the pad far away, ghosts.
-    pub fn fill_positions(&self, centres: [&[f64]; 3], out: [&mut Vec<f64>; 3]) {
-        for (d, v) in out.into_iter().enumerate() {
+    pub fn fill_positions(&self, centres: [&[f64]; 3], mut out: [&mut Vec<f64>; 3]) {
+        for (d, v) in out.iter_mut().enumerate() {
             v.clear();
             v.extend(self.order.iter().map(|&s| {
                 let s = s as usize;
                 centres[d][s] + self.offset[s][d]
             }));
             v.push(PAD_POSITION);
-            for &(slot, shift) in &self.ghosts {
+        }
+        self.extend_positions(out);
+    }
+
+    /// Append to `out` (filled by [`NeighbourList::fill_positions`] before ghost slots were
+    /// added) the positions of the ghost slots they lack, from the slots they copy.
+    pub fn extend_positions(&self, out: [&mut Vec<f64>; 3]) {
+        let first = self.order.len() + 1;
+        for (d, v) in out.into_iter().enumerate() {
+            for g in v.len().max(first)..self.slots() {
+                let (slot, shift) = self.ghosts[g - first];
                 let p = v[slot as usize] + shift[d];
                 v.push(p);
             }
@@ -402,8 +414,15 @@ impl NeighbourList {
         v.clear();
         v.extend(self.order.iter().map(|&s| of(s as usize)));
         v.push(pad);
-        for &(slot, _) in &self.ghosts {
-            let x = v[slot as usize];
+        self.extend_values(v);
+    }
+
+    /// Append to `v` (filled by [`NeighbourList::fill_values`] before ghost slots were added) the
+    /// values of the ghost slots it lacks, their swimmers'.
+    pub fn extend_values<T: Copy>(&self, v: &mut Vec<T>) {
+        let first = self.order.len() + 1;
+        for g in v.len().max(first)..self.slots() {
+            let x = v[self.ghosts[g - first].0 as usize];
             v.push(x);
         }
     }

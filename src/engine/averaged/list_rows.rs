@@ -6,7 +6,8 @@
 //! pair is a plain difference. Each lane accumulates its own partners and the lanes are summed
 //! in a fixed order: a row depends on neither the thread count nor the vector width.
 
-use super::lanes::{prefactors, side, Acc};
+use super::lanes::{side, Acc};
+use super::listed::SlotConst;
 use super::{AveragedSystem, CutoffSwitch, Soa};
 use crate::engine::neighbours::NeighbourList;
 use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
@@ -44,10 +45,10 @@ fn row_impl(
     sys: &AveragedSystem,
     list: &NeighbourList,
     slots: &Soa,
+    consts: &[SlotConst],
     k: usize,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let s = list.order[k] as usize;
-    let pre = prefactors(sys, &sys.coef[s]);
+    let pre = consts[k].pre;
     if pre[2] != 0.0 || pre[3] != 0.0 {
         row_with::<true>(sys, list, slots, k, pre)
     } else {
@@ -118,5 +119,5 @@ fn row_with<const IK: bool>(
 
 vector_dispatch! {
     /// dR_H/dt of the swimmer in slot `k` and its torque-like sum T over its far partners.
-    pub(super) fn row(sys: &AveragedSystem, list: &NeighbourList, slots: &Soa, k: usize) -> (Vector3<f64>, Vector3<f64>) = row_impl;
+    pub(super) fn row(sys: &AveragedSystem, list: &NeighbourList, slots: &Soa, consts: &[SlotConst], k: usize) -> (Vector3<f64>, Vector3<f64>) = row_impl;
 }

@@ -15,12 +15,28 @@ use rayon::prelude::*;
 /// instead of relisting them one by one.
 pub const MAX_RELISTED_FRACTION: f64 = 0.1;
 
+/// A swimmer's constants, kept by slot so that a pass in slot order reads them in order.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct SlotConst {
+    /// The far rows' prefactors ([`super::lanes::prefactors`]).
+    pub(super) pre: [f64; 4],
+    /// Its length ℓ (m).
+    ell: f64,
+    /// Its spheres' weights (w1, w2): the spheres sit at −w2ℓN and +w1ℓN from its centre.
+    w: (f64, f64),
+    /// Its sphere radii (m).
+    a: [f64; 2],
+}
+
 /// The list and the arrays in its slot order.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Listed {
     list: Option<NeighbourList>,
     /// Positions and orientations by slot (swimmers, ghosts, the pad).
     slots: Soa,
+    /// Constants by slot (swimmers, ghosts, the pad), for the list built `consts_of`-th.
+    consts: Vec<SlotConst>,
+    consts_of: Option<u64>,
     /// Scratch: rates by slot.
     rates: Vec<[f64; 6]>,
     /// Scratch: steric forces on each slot's two spheres.
@@ -89,7 +105,8 @@ impl AveragedSystem {
 
     /// Relist the swimmers `moved` (at their centres in the arrays), or rebuild the whole list
     /// when `None` or when more than [`MAX_RELISTED_FRACTION`] of the swimmers moved. Returns
-    /// whether the slot arrays need refilling (new slots).
+    /// whether the list was rebuilt (the slot arrays then need refilling; after a relisting,
+    /// only the ghost slots it added need filling).
     pub(super) fn relist(&mut self, moved: Option<Vec<usize>>) -> bool {
         let (sin, cos, skip) = (&self.sin_phi, &self.cos_phi, self.skip_zero_phase);
         let weight = |i: usize, j: usize| pair_weight(sin, cos, skip, i, j);
@@ -97,11 +114,10 @@ impl AveragedSystem {
         let n = self.coef.len();
         match (moved, &mut self.listed.list) {
             (Some(m), Some(list)) if (m.len() as f64) <= MAX_RELISTED_FRACTION * n as f64 => {
-                let mut grown = false;
                 for s in m {
-                    grown |= list.relist(s, [soa.x[s], soa.y[s], soa.z[s]], &weight);
+                    list.relist(s, [soa.x[s], soa.y[s], soa.z[s]], &weight);
                 }
-                grown
+                false
             }
             _ => {
                 let spec = self.list_spec();
@@ -121,8 +137,36 @@ impl AveragedSystem {
         }
     }
 
+    /// Swimmer `s`'s constants.
+    fn slot_const(&self, s: usize) -> SlotConst {
+        let c = &self.coef[s];
+        SlotConst {
+            pre: super::lanes::prefactors(self, c),
+            ell: c.ell,
+            w: self.weights[s],
+            a: [self.radii[2 * s], self.radii[2 * s + 1]],
+        }
+    }
+
+    /// The constants by slot: all of them for a list built since they were filled, else those
+    /// of ghost slots added since.
+    fn refill_consts(&mut self) {
+        let Some(list) = &self.listed.list else {
+            return;
+        };
+        let mut consts = std::mem::take(&mut self.listed.consts);
+        if self.listed.consts_of == Some(self.listed.builds) {
+            list.extend_values(&mut consts);
+        } else {
+            list.fill_values(|s| self.slot_const(s), SlotConst::default(), &mut consts);
+            self.listed.consts_of = Some(self.listed.builds);
+        }
+        self.listed.consts = consts;
+    }
+
     /// The slot arrays from the arrays in state order.
     pub(super) fn refill_slots(&mut self) {
+        self.refill_consts();
         let Some(list) = &self.listed.list else {
             return;
         };
@@ -138,6 +182,20 @@ impl AveragedSystem {
         ] {
             list.fill_values(|s| from[s], 0.0, to);
         }
+    }
+
+    /// The slot arrays' entries for ghost slots added since they were filled, from the slots
+    /// they copy.
+    pub(super) fn extend_slots(&mut self) {
+        let Some(list) = &self.listed.list else {
+            return;
+        };
+        let slots = &mut self.listed.slots;
+        list.extend_positions([&mut slots.x, &mut slots.y, &mut slots.z]);
+        for v in [&mut slots.nx, &mut slots.ny, &mut slots.nz] {
+            list.extend_values(v);
+        }
+        self.refill_consts();
     }
 
     /// The neighbour list in use, if any.
@@ -157,11 +215,13 @@ impl AveragedSystem {
         list.set_value(s, n[2], &mut slots.nz);
     }
 
-    /// Swimmer `s`'s sphere centres if it sat in slot `k` (length ℓ, as [`AveragedSystem::fill`]).
-    fn slot_spheres(&self, slots: &Soa, k: usize, s: usize) -> [Vector3<f64>; 2] {
+    /// The sphere centres of the swimmer in slot `k` (length ℓ, as [`AveragedSystem::fill`]).
+    fn slot_spheres(&self, slots: &Soa, k: usize) -> [Vector3<f64>; 2] {
         let c = Vector3::new(slots.x[k], slots.y[k], slots.z[k]);
-        let b = Vector3::new(slots.nx[k], slots.ny[k], slots.nz[k]) * self.coef[s].ell;
-        let (w1, w2) = self.weights[s];
+        let SlotConst {
+            ell, w: (w1, w2), ..
+        } = self.listed.consts[k];
+        let b = Vector3::new(slots.nx[k], slots.ny[k], slots.nz[k]) * ell;
         [c - w2 * b, c + w1 * b]
     }
 
@@ -199,14 +259,13 @@ impl AveragedSystem {
         slots: &Soa,
         k: usize,
     ) -> [Vector3<f64>; 2] {
-        let s = list.order[k] as usize;
-        let a = self.slot_spheres(slots, k, s);
-        let ra = [self.radii[2 * s], self.radii[2 * s + 1]];
+        let consts = &self.listed.consts;
+        let a = self.slot_spheres(slots, k);
+        let ra = consts[k].a;
         let mut f = [Vector3::zeros(); 2];
         for &p in list.near_row(k) {
-            let r = list.swimmer_of(p as usize);
-            let b = self.slot_spheres(slots, p as usize, r);
-            let rb = [self.radii[2 * r], self.radii[2 * r + 1]];
+            let b = self.slot_spheres(slots, p as usize);
+            let rb = consts[p as usize].a;
             let df = st.swimmer_pair_forces(a, ra, b, rb);
             f[0] += df[0];
             f[1] += df[1];
@@ -215,16 +274,29 @@ impl AveragedSystem {
     }
 
     /// Fill `dy` from the far rows (and the steric rates), slot by slot in parallel.
-    pub(super) fn rows_by_list(&mut self, y: &[f64], dy: &mut [f64]) {
+    pub(super) fn rows_by_list(&mut self, dy: &mut [f64]) {
         let Some(list) = &self.listed.list else {
             return;
         };
         let slots = &self.listed.slots;
         let mut rates = std::mem::take(&mut self.listed.rates);
         rates.resize(list.len(), [0.0; 6]);
+        let (consts, forces) = (&self.listed.consts, &self.listed.forces);
+        let steric = self.contacts.steric.is_some();
+        // The rates in slot order, from the slot arrays (equal to the state's entries) and the
+        // steric forces by slot: dN/dt = −(1 − NNᵀ)T, plus the steric rates.
         let one = |k: usize, out: &mut [f64; 6]| {
-            let (v, t) = list_rows::row(self, list, slots, k);
-            self.finish_rates(list.order[k] as usize, y, v, t, out);
+            let (mut v, t) = list_rows::row(self, list, slots, consts, k);
+            let n = Vector3::new(slots.nx[k], slots.ny[k], slots.nz[k]);
+            let mut dn = -(t - n * n.dot(&t));
+            if steric {
+                let c = consts[k];
+                let (vs, ns) = self.steric_rates_with(c.a, c.ell, n, forces[k]);
+                v += vs;
+                dn += ns;
+            }
+            out[..3].copy_from_slice(v.as_slice());
+            out[3..6].copy_from_slice(dn.as_slice());
         };
         if list.len() >= PARALLEL_SWIMMERS {
             rates
@@ -321,10 +393,10 @@ impl AveragedSystem {
         }
         let closest = |k: usize| -> Option<(f64, usize, usize)> {
             let s = list.order[k] as usize;
-            let a = self.slot_spheres(slots, k, s);
+            let a = self.slot_spheres(slots, k);
             let mut best: Option<(f64, usize, usize)> = None;
             for (p, r) in partners(k).filter(|&(_, r)| r > s) {
-                let b = self.slot_spheres(slots, p, r);
+                let b = self.slot_spheres(slots, p);
                 for (i, x) in a.iter().enumerate() {
                     for (j, z) in b.iter().enumerate() {
                         let gap = (x - z).norm() - self.radii[2 * s + i] - self.radii[2 * r + j];

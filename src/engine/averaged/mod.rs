@@ -384,11 +384,22 @@ impl AveragedSystem {
         n: Vector3<f64>,
         f: [Vector3<f64>; 2],
     ) -> (Vector3<f64>, Vector3<f64>) {
+        let a = [self.radii[2 * s], self.radii[2 * s + 1]];
+        self.steric_rates_with(a, self.coef[s].ell, n, f)
+    }
+
+    /// [`AveragedSystem::steric_rates_of`] of a swimmer with sphere radii `a` and length `ell`.
+    fn steric_rates_with(
+        &self,
+        a: [f64; 2],
+        ell: f64,
+        n: Vector3<f64>,
+        f: [Vector3<f64>; 2],
+    ) -> (Vector3<f64>, Vector3<f64>) {
         let [f1, f2] = f;
-        let (a1, a2) = (self.radii[2 * s], self.radii[2 * s + 1]);
+        let [a1, a2] = a;
         let v = (f1 + f2) * self_mobility(self.mu, a1 + a2);
-        let rel =
-            (f2 * self_mobility(self.mu, a2) - f1 * self_mobility(self.mu, a1)) / self.coef[s].ell;
+        let rel = (f2 * self_mobility(self.mu, a2) - f1 * self_mobility(self.mu, a1)) / ell;
         (v, rel - n * n.dot(&rel))
     }
 
@@ -681,7 +692,7 @@ impl OdeSystem for AveragedSystem {
             if let Some(st) = self.contacts.steric {
                 self.steric_by_list(st);
             }
-            return self.rows_by_list(y, dy);
+            return self.rows_by_list(dy);
         }
         if let Some(st) = self.contacts.steric {
             // The sphere models' pair force, on the spheres at length ℓ.

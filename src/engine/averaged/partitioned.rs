@@ -63,7 +63,7 @@ impl Partitioned for AveragedSystem {
         }
         if self.shares_rates() {
             // Swimmers that left their lists are relisted (their array and slot entries set from
-            // `y` first, as a relisting reads them; new ghosts need the slot arrays refilled).
+            // `y` first, as a relisting reads them; new ghosts get their slot entries).
             // Nothing else is written: the rates read the states from `y`.
             let moved: Vec<usize> = changed
                 .iter()
@@ -76,6 +76,7 @@ impl Partitioned for AveragedSystem {
             if self.relist(Some(moved.clone())) {
                 self.refill_slots();
             } else {
+                self.extend_slots();
                 for &s in &moved {
                     self.refresh_slot(s);
                 }

@@ -95,6 +95,24 @@ pub struct Suspension {
 /// A refined group's path across a coarse step: (time from its start, the group's states).
 type Path = Vec<(f64, Vec<f64>)>;
 
+/// What the rounds of refining one coarse step keep for the next round.
+#[derive(Default)]
+struct Rounds {
+    /// Each group refined so far, by its swimmers.
+    groups: std::collections::HashMap<Vec<usize>, Refined>,
+    /// The swimmers of the groups refined since the read errors were last found.
+    changed: Vec<usize>,
+    /// The neighbours' largest read errors so far (see [`Suspension::ring_of`]).
+    worst: std::collections::HashMap<usize, f64>,
+    /// Scratch of the read errors, by swimmer.
+    read: Vec<f64>,
+    /// The swimmers of the groups refined since the ring was last stepped again.
+    redo_changed: Vec<usize>,
+    /// Each part of the ring stepped again so far, by its swimmers: their new states (by
+    /// component) and errors.
+    ring: std::collections::HashMap<Vec<usize>, (Vec<f64>, Vec<f64>)>,
+}
+
 /// Scratch of a refinement: the working state (the refined swimmers at their sub-step, the others
 /// interpolated), stages and rates.
 #[derive(Debug, Clone, Default)]
@@ -344,6 +362,10 @@ impl Suspension {
         let mut settled = false;
         // The coarse step's states: refinement overwrites the refined swimmers' in `y_new`.
         let coarse = self.y_new.clone();
+        // What a round keeps for the next: a group's refinement reads only the coarse step, and a
+        // neighbour's read error only its refined partners' paths, so both stand until the
+        // refined swimmers around them change.
+        let mut kept = Rounds::default();
         for _ in 0..RING_ROUNDS {
             // Swimmers that read none of each other's states take their own steps.
             self.prepare_sub(y, n);
@@ -352,7 +374,7 @@ impl Suspension {
             // A contact forming between a group and a swimmer outside it: both join the refined
             // swimmers and the round is taken again.
             let groups = groups_of(p, &refined);
-            match self.refine_groups(p, t, h, y, &coarse, &groups, &floor) {
+            match self.refine_groups(p, t, h, y, &coarse, &groups, &floor, &mut kept) {
                 Ok(taken) => steps = taken,
                 Err(Refusal::Crossing(more)) => {
                     refined = closure(refined.into_iter().chain(more).collect(), jac, bs);
@@ -360,13 +382,13 @@ impl Suspension {
                 }
                 Err(_) => return (f64::INFINITY, false),
             }
-            ring = self.ring_of(p, h, y, &coarse, &refined, &e, &floor, jac);
+            ring = self.ring_of(p, h, y, &coarse, &refined, &e, &floor, jac, &mut kept);
             if refined.len() + ring.len() > most.max(1) * 8 {
                 // Stepping again a ring this large costs more than a shorter step for all: the
                 // step the fast swimmers need unrefined.
                 return (worst, false);
             }
-            let missed = self.redo_ring(p, t, h, y, &refined, &ring, &floor);
+            let missed = self.redo_ring(p, t, h, y, &refined, &ring, &floor, &mut kept);
             if missed.is_empty() {
                 settled = true;
                 break;
@@ -553,11 +575,12 @@ impl Suspension {
         Ok(Refined { comps, path, steps })
     }
 
-    /// Refine every group of `groups` (see [`Suspension::refine`]): on rayon's threads, each
-    /// with scratch of its own, when the system's rates can be read shared; a group whose
-    /// swimmers left the system's neighbour data, and every group otherwise, on this thread.
-    /// Their new states go into `y_new` and their paths into `self.paths`; the steps taken, or
-    /// the refusal of the first group refused.
+    /// Refine every group of `groups` (see [`Suspension::refine`]) not refined in an earlier
+    /// round (`kept`): on rayon's threads, each with scratch of its own, when the system's rates
+    /// can be read shared; a group whose swimmers left the system's neighbour data, and every
+    /// group otherwise, on this thread. Their new states go into `y_new` and their paths into
+    /// `self.paths`, the swimmers of the groups refined now added to `kept.changed`; the steps taken,
+    /// or the refusal of the first group refused.
     #[allow(clippy::too_many_arguments)]
     fn refine_groups(
         &mut self,
@@ -568,14 +591,23 @@ impl Suspension {
         coarse: &[f64],
         groups: &[Vec<usize>],
         floor: &[f64],
+        kept: &mut Rounds,
     ) -> Result<u64, Refusal> {
         let (tol, f0) = (self.tol, &self.f0);
+        let new: Vec<&Vec<usize>> = groups
+            .iter()
+            .filter(|g| !kept.groups.contains_key(*g))
+            .collect();
+        for changed in [&mut kept.changed, &mut kept.redo_changed] {
+            changed.extend(new.iter().flat_map(|g| g.iter().copied()));
+            changed.sort_unstable();
+            changed.dedup();
+        }
         let mut results: Vec<Result<Refined, Refusal>> =
-            if groups.len() >= PARALLEL_GROUPS && p.shares_rates() {
+            if new.len() >= PARALLEL_GROUPS && p.shares_rates() {
                 let shared: &dyn Partitioned = p;
                 let pool = &self.pool.0;
-                groups
-                    .par_iter()
+                new.par_iter()
                     .map(|group| {
                         // Scratch from the pool (a thread working on two groups at once, as
                         // rayon may nest, takes a second).
@@ -603,9 +635,9 @@ impl Suspension {
                     })
                     .collect()
             } else {
-                groups.iter().map(|_| Err(Refusal::Relist)).collect()
+                new.iter().map(|_| Err(Refusal::Relist)).collect()
             };
-        for (group, result) in groups.iter().zip(results.iter_mut()) {
+        for (group, result) in new.iter().zip(results.iter_mut()) {
             if matches!(result, Err(Refusal::Relist)) {
                 *result = Self::refine(
                     &mut self.sub,
@@ -621,22 +653,11 @@ impl Suspension {
                 );
             }
         }
-        let mut steps = 0;
         let mut crossing = Vec::new();
-        for result in results {
+        for (group, result) in new.into_iter().zip(results) {
             match result {
-                Ok(Refined {
-                    comps,
-                    path,
-                    steps: taken,
-                }) => {
-                    if let Some((_, end)) = path.last() {
-                        for (&m, &v) in comps.iter().zip(end) {
-                            self.y_new[m] = v;
-                        }
-                    }
-                    self.paths.push((comps, path));
-                    steps += taken;
+                Ok(refined) => {
+                    kept.groups.insert(group.clone(), refined);
                 }
                 Err(Refusal::Crossing(more)) => crossing.extend(more),
                 Err(refusal) => return Err(refusal),
@@ -644,6 +665,24 @@ impl Suspension {
         }
         if !crossing.is_empty() {
             return Err(Refusal::Crossing(crossing));
+        }
+        let mut steps = 0;
+        for group in groups {
+            let Some(Refined {
+                comps,
+                path,
+                steps: taken,
+            }) = kept.groups.get(group)
+            else {
+                continue;
+            };
+            if let Some((_, end)) = path.last() {
+                for (&m, &v) in comps.iter().zip(end) {
+                    self.y_new[m] = v;
+                }
+            }
+            self.paths.push((comps.clone(), path.clone()));
+            steps += taken;
         }
         Ok(steps)
     }
@@ -672,7 +711,9 @@ impl Suspension {
     /// `self.paths`, their coarse states in `coarse`): those whose rates change, when they read
     /// the refined path instead of the coarse one (at the step's middle and end), by more than
     /// [`RING_SHARE`] of the tolerance, or by more than their coarse error `e` leaves to it; with
-    /// every swimmer in a stiff group of `jac` with one of them, none refined.
+    /// every swimmer in a stiff group of `jac` with one of them, none refined. Read errors found
+    /// in an earlier round (`kept`) stand for swimmers none of whose partners were refined anew
+    /// (`kept.changed`).
     #[allow(clippy::too_many_arguments)]
     fn ring_of(
         &mut self,
@@ -684,30 +725,48 @@ impl Suspension {
         e: &[f64],
         floor: &[f64],
         jac: &GroupJacobian,
+        kept: &mut Rounds,
     ) -> Vec<usize> {
         let bs = p.body_size();
         let mut near = Vec::new();
         p.partners(refined, &mut near);
+        let mut anew = Vec::new();
+        p.partners(&std::mem::take(&mut kept.changed), &mut anew);
+        anew.retain(|b| refined.binary_search(b).is_err());
         let comps: Vec<usize> = refined
             .iter()
-            .chain(&near)
+            .chain(&anew)
             .flat_map(|&b| b * bs..(b + 1) * bs)
             .collect();
-        let mut read = vec![0.0; e.len()];
-        let mut worst = vec![0.0f64; e.len()];
         self.coarse_and_refined(y, coarse, h, &comps);
+        kept.read.resize(e.len(), 0.0);
+        for &b in &anew {
+            kept.worst.insert(b, 0.0);
+        }
         for (before, after) in &self.views {
             p.read_errors(
-                before, after, &near, refined, h, &self.f0, self.tol, floor, &mut read,
+                before,
+                after,
+                &anew,
+                refined,
+                h,
+                &self.f0,
+                self.tol,
+                floor,
+                &mut kept.read,
             );
-            for &b in &near {
-                worst[b] = worst[b].max(read[b]);
+            for &b in &anew {
+                if let Some(w) = kept.worst.get_mut(&b) {
+                    *w = w.max(kept.read[b]);
+                }
             }
         }
         let moved: Vec<usize> = near
             .into_iter()
             .filter(|&b| {
-                let r = worst[b];
+                // A swimmer near the refined ones is near a group refined anew or was near one
+                // in an earlier round.
+                let r = kept.worst.get(&b).copied().unwrap_or(f64::NAN);
                 r.is_nan() || r > RING_SHARE || r + e[b] > 1.0
             })
             .collect();
@@ -719,9 +778,11 @@ impl Suspension {
 
     /// Take the coarse step again for the swimmers `ring` that read the refined ones, now reading
     /// those along their refined path (linear between their steps) and the rest from the coarse
-    /// step: what the refined swimmers' coarse states did to them is undone. The ring swimmers
-    /// that then miss the tolerance (all of them when a contact forms with a swimmer outside);
-    /// the others' new states go into `y_new`.
+    /// step: what the refined swimmers' coarse states did to them is undone. The ring's parts
+    /// that read none of each other's states are stepped apart; a part stepped in an earlier
+    /// round (`kept`) stands while none of its partners was refined anew. The ring swimmers that
+    /// then miss the tolerance (all of a part's when a contact forms with a swimmer outside it);
+    /// when none does, their new states go into `y_new`.
     #[allow(clippy::too_many_arguments)]
     fn redo_ring(
         &mut self,
@@ -732,65 +793,110 @@ impl Suspension {
         refined: &[usize],
         ring: &[usize],
         floor: &[f64],
+        kept: &mut Rounds,
     ) -> Vec<usize> {
         if ring.is_empty() {
             return Vec::new();
         }
         let bs = p.body_size();
         let mut partners = Vec::new();
-        p.partners(ring, &mut partners);
-        let others: Vec<usize> = partners
-            .iter()
-            .filter(|b| refined.binary_search(b).is_err())
-            .flat_map(|&b| b * bs..(b + 1) * bs)
-            .collect();
-        let mut changed: Vec<usize> = ring.iter().chain(&partners).copied().collect();
-        changed.sort_unstable();
-        changed.dedup();
+        // Parts whose partners were refined anew read other paths now.
+        let changed = std::mem::take(&mut kept.redo_changed);
+        kept.ring.retain(|part, _| {
+            p.partners(part, &mut partners);
+            !partners.iter().any(|b| changed.binary_search(b).is_ok())
+        });
+        let parts = groups_of(p, ring);
         self.prepare_sub(y, y.len() / bs.max(1));
-        let (y_new, f0, paths) = (&self.y_new, &self.f0, &self.paths);
-        let at = |yw: &mut [f64], time: f64| {
-            Self::coarse_at(y, y_new, f0, h, &others, yw, (time - t) / h);
-            let tau = time - t;
-            for (comps, path) in paths {
-                for (&m, v) in comps.iter().zip(path_at(path, tau)) {
-                    yw[m] = v;
+        let mut missed = Vec::new();
+        for part in &parts {
+            if let Some((_, errors)) = kept.ring.get(part) {
+                missed.extend(
+                    part.iter()
+                        .zip(errors)
+                        .filter(|(_, e)| e.is_nan() || **e > 1.0)
+                        .map(|(b, _)| *b),
+                );
+                continue;
+            }
+            p.partners(part, &mut partners);
+            let others: Vec<usize> = partners
+                .iter()
+                .filter(|b| refined.binary_search(b).is_err())
+                .flat_map(|&b| b * bs..(b + 1) * bs)
+                .collect();
+            // The refined paths this part reads.
+            let read_paths: Vec<&(Vec<usize>, Path)> = self
+                .paths
+                .iter()
+                .filter(|(comps, _)| {
+                    comps
+                        .iter()
+                        .step_by(bs)
+                        .any(|m| partners.binary_search(&(m / bs)).is_ok())
+                })
+                .collect();
+            let mut changed: Vec<usize> = part.iter().chain(&partners).copied().collect();
+            changed.sort_unstable();
+            changed.dedup();
+            let (y_new, f0) = (&self.y_new, &self.f0);
+            let at = |yw: &mut [f64], time: f64| {
+                Self::coarse_at(y, y_new, f0, h, &others, yw, (time - t) / h);
+                let tau = time - t;
+                for (comps, path) in &read_paths {
+                    for (&m, v) in comps.iter().zip(path_at(path, tau)) {
+                        yw[m] = v;
+                    }
                 }
+            };
+            let sub = &mut self.sub;
+            match Self::subset_step(
+                sub,
+                &mut Access::Own(&mut *p),
+                self.tol,
+                t,
+                h,
+                part,
+                &changed,
+                floor,
+                &at,
+            ) {
+                Ok(_) => {
+                    let states = part
+                        .iter()
+                        .flat_map(|&b| b * bs..(b + 1) * bs)
+                        .map(|m| sub.y1[m])
+                        .collect();
+                    let errors: Vec<f64> = part.iter().map(|&b| sub.errors[b]).collect();
+                    missed.extend(
+                        part.iter()
+                            .zip(&errors)
+                            .filter(|(_, e)| e.is_nan() || **e > 1.0)
+                            .map(|(b, _)| *b),
+                    );
+                    kept.ring.insert(part.clone(), (states, errors));
+                }
+                // The part's swimmers and outsiders of contacts forming across its edge.
+                Err(Refusal::Crossing(crossing)) => missed.extend(
+                    crossing
+                        .into_iter()
+                        .filter(|b| refined.binary_search(b).is_err()),
+                ),
+                Err(_) => missed.extend(part.iter().copied()),
             }
-        };
-        match Self::subset_step(
-            &mut self.sub,
-            &mut Access::Own(p),
-            self.tol,
-            t,
-            h,
-            ring,
-            &changed,
-            floor,
-            &at,
-        ) {
-            Ok(_) => {}
-            // The ring swimmers and outsiders of contacts forming across the ring's edge.
-            Err(Refusal::Crossing(crossing)) => {
-                return crossing
-                    .into_iter()
-                    .filter(|b| refined.binary_search(b).is_err())
-                    .collect()
-            }
-            Err(_) => return ring.to_vec(),
         }
-        let missed: Vec<usize> = ring
-            .iter()
-            .copied()
-            .filter(|&b| self.sub.errors[b].is_nan() || self.sub.errors[b] > 1.0)
-            .collect();
         if missed.is_empty() {
-            for &b in ring {
-                for m in b * bs..(b + 1) * bs {
-                    self.y_new[m] = self.sub.y1[m];
+            for part in &parts {
+                if let Some((states, _)) = kept.ring.get(part) {
+                    let comps = part.iter().flat_map(|&b| b * bs..(b + 1) * bs);
+                    for (m, &v) in comps.zip(states) {
+                        self.y_new[m] = v;
+                    }
                 }
             }
         }
+        missed.sort_unstable();
+        missed.dedup();
         missed
     }
 }
