@@ -133,3 +133,40 @@ fn rosenbrock_is_not_held_by_the_spring_stability_limit() {
         "{steps} steps per period, explicit limit {rate_steps}"
     );
 }
+
+/// In a periodic box the rigid-stroke tension is the one the run's constraint solve uses, with
+/// the box's (Ewald-summed) mobility: for one swimmer, T = L̇ / c with c the rate at which a unit
+/// tension (+N on the a1 sphere, −N on the a2 sphere) pulls the spheres apart along N, read from
+/// the scene's sphere velocities in the box. A box of side 4ℓ changes the tension by 0.7%, so
+/// open space's tension fails this; the two agree to 1e-8, the Ewald sums' tolerance with room.
+#[test]
+fn the_rigid_tension_in_a_box_uses_the_box_mobility() {
+    let d = swimmer(0.15, true, 0.3);
+    let build = |side: Option<f64>| {
+        let mut s = Scene::new();
+        s.set_model(Model::Rigid);
+        if let Some(l) = side {
+            s.set_box(Some([l; 3])).unwrap();
+        }
+        s.add(d, Vector3::zeros(), Vector3::new(1.0, 0.4, -0.2))
+            .unwrap();
+        s
+    };
+    let s = build(Some(4.0 * d.ell));
+    let n = s.dir(0).unwrap();
+    let unit = 1e-12;
+    let u = s.sphere_velocities(&[n * unit, -n * unit]).unwrap();
+    let c = (u[1] - u[0]).dot(&n) / unit;
+    let l_dot = d.lambda * d.omega * d.phase.cos();
+    let expected = l_dot / c;
+    let t = s.tension(0).unwrap();
+    assert!(
+        ((t - expected) / expected).abs() < 1e-8,
+        "tension {t:e} N, constraint with the box's mobility {expected:e} N"
+    );
+    let open = build(None).tension(0).unwrap();
+    assert!(
+        ((open - expected) / expected).abs() > 1e-3,
+        "the box does not change the tension ({open:e} against {expected:e}): the test cannot tell"
+    );
+}

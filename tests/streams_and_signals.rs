@@ -220,3 +220,60 @@ fn a_closed_standard_output_ends_a_piped_session_quietly() {
     assert_eq!(status.code(), Some(141), "stderr:\n{err}");
     assert!(err.is_empty(), "quietly: {err}");
 }
+
+/// A stream whose file cannot grow (a full disk; here the process's file size limit, 8 KiB, the
+/// write failing part way through a row as it does when a disk fills) is cut back to its last
+/// whole row; the run stops with the write error, which names the file and the fix, and the
+/// recorder keeps its rows in memory (the script reads them after the error).
+#[test]
+fn a_stream_that_cannot_grow_keeps_whole_rows_and_stops_the_run_with_the_error() {
+    let d = dir("full");
+    let csv = d.join("rows.csv");
+    let script = d.join("full.rhai");
+    std::fs::write(
+        &script,
+        format!(
+            "import \"paper\" as paper;\nlet s = paper::mirror(10.0, true, true);\nlet r = s.record([R_H(0), length(1)], every_periods(0.05));\nr.stream_csv(\"{}\");\ntry {{ s.run_periods(1000); print(\"ran through\"); }} catch (e) {{ print(`stopped: ${{e}}`); }}\nprint(`rows in memory: ${{r.rows.len()}}`);\n",
+            csv.display()
+        ),
+    )
+    .unwrap();
+    // bash's `ulimit -f` counts 1,024-byte blocks; SIGXFSZ ignored, so a write past the limit
+    // fails with EFBIG (after writing what fits) instead of killing the process.
+    let out = Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 8; trap '' XFSZ; exec '{}' run '{}'",
+            env!("CARGO_BIN_EXE_swimlab"),
+            script.display()
+        ))
+        .env("SWIMLAB_PROGRESS", "0")
+        .stdin(Stdio::null())
+        .output()
+        .expect("run swimlab");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("stopped: "), "{stdout}");
+    assert!(
+        stdout.contains("cannot write") && stdout.contains("disk not full"),
+        "{stdout}"
+    );
+    let size = std::fs::metadata(&csv).unwrap().len();
+    assert!(size <= 8192, "{size} bytes");
+    let rows = whole_rows(&csv);
+    // About 8 KiB of ~50-byte rows were written before the limit.
+    assert!(rows > 100, "{rows} rows");
+    let in_memory: usize = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("rows in memory: "))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(
+        in_memory >= rows,
+        "{in_memory} rows in memory, {rows} in the file"
+    );
+}

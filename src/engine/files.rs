@@ -11,7 +11,7 @@
 //! no more.
 
 use super::error::{invalid, Result};
-use std::io::Write;
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -252,12 +252,15 @@ pub fn write_atomically(
 }
 
 /// A file that rows are appended to as they are recorded, one whole line per write; claimed
-/// while the stream lives.
+/// while the stream lives. A write that fails part way (a full disk, a file size limit) is cut
+/// back to the last whole line.
 #[derive(Debug)]
 pub struct LineStream {
     file: std::fs::File,
     path: PathBuf,
     claim: Claim,
+    /// Bytes of whole lines written.
+    len: u64,
 }
 
 impl LineStream {
@@ -281,6 +284,7 @@ impl LineStream {
             file,
             path: path.to_path_buf(),
             claim,
+            len: 0,
         };
         for line in first {
             s.append(line)?;
@@ -293,8 +297,10 @@ impl LineStream {
         self.claim.is_on(path)
     }
 
-    /// Append one line (a newline is added) with a single write, so that the file never ends
-    /// in half a line. Nothing is written once another writer took the file over.
+    /// Append one line (a newline is added) with a single write, so that a kill never leaves
+    /// half a line; a write that fails part way is cut back to the last whole line (and the
+    /// next append continues from there). Nothing is written once another writer took the file
+    /// over.
     pub fn append(&mut self, line: &str) -> Result<()> {
         if self.claim.lost() {
             return Ok(());
@@ -302,8 +308,18 @@ impl LineStream {
         let mut buf = String::with_capacity(line.len() + 1);
         buf.push_str(line);
         buf.push('\n');
-        self.file
-            .write_all(buf.as_bytes())
-            .map_err(|e| write_error(&self.path, e))
+        match self.file.write_all(buf.as_bytes()) {
+            Ok(()) => {
+                self.len += buf.len() as u64;
+                Ok(())
+            }
+            Err(e) => {
+                // Cutting back frees what the partial line took, so it succeeds on a full disk;
+                // should it fail too, the write's error is still the one to tell.
+                let _ = self.file.set_len(self.len);
+                let _ = self.file.seek(std::io::SeekFrom::Start(self.len));
+                Err(write_error(&self.path, e))
+            }
+        }
     }
 }

@@ -14,16 +14,7 @@ impl Scene {
                 let d = &self.swimmers[i];
                 Ok(d.k0 * (self.length(i)? - d.rest_length(self.time)))
             }
-            Model::Rigid => {
-                let mut sys = RigidSystem::new(
-                    &self.swimmers,
-                    &self.base,
-                    self.mu,
-                    self.mobility,
-                    self.contacts.allow_overlap,
-                );
-                Ok(sys.tensions(self.time, &self.state)[i])
-            }
+            Model::Rigid => Ok(self.rigid_system()?.tensions(self.time, &self.state)[i]),
             Model::Averaged => Err(unsupported(
                 format!("tension({i}) does not exist in the averaged model (it has no springs)"),
                 &[Setting::Model("micro"), Setting::Model("rigid")],
@@ -93,16 +84,7 @@ impl Scene {
                         &[Setting::Model("micro"), Setting::Model("averaged"), Setting::NoSteric],
                     ));
                 }
-                let mut sys = RigidSystem::new(
-                    &self.swimmers,
-                    &self.base,
-                    self.mu,
-                    self.mobility,
-                    self.contacts.allow_overlap,
-                );
-                // The constraint solve takes blocks, which are Beenakker's sums.
-                sys.set_periodic(self.ewald_by(EwaldMethod::Beenakker)?);
-                Box::new(sys)
+                Box::new(self.rigid_system()?)
             }
             Model::Averaged => {
                 self.check_averaged()?;
@@ -115,6 +97,21 @@ impl Scene {
                 Box::new(sys)
             }
         })
+    }
+
+    /// The rigid-stroke model's system for the current settings (steric repulsion aside, which
+    /// [`Scene::system`] refuses): the one every run and the tensions use.
+    fn rigid_system(&self) -> Result<RigidSystem> {
+        let mut sys = RigidSystem::new(
+            &self.swimmers,
+            &self.base,
+            self.mu,
+            self.mobility,
+            self.contacts.allow_overlap,
+        );
+        // The constraint solve takes blocks, which are Beenakker's sums.
+        sys.set_periodic(self.ewald_by(EwaldMethod::Beenakker)?);
+        Ok(sys)
     }
 
     /// The averaged model's cutoff: the one set; in a box at most half its shortest side (a pair
