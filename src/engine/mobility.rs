@@ -134,7 +134,8 @@ impl Mobility {
         for a in 0..n {
             for b in (a + 1)..n {
                 let r = pos[a] - pos[b];
-                // H is even in r, so one evaluation serves both directions of the pair.
+                // H is even in r and symmetric in the two radii: the same r serves both
+                // directions of the pair.
                 let ua = self.pair_apply(mu, &r, radii[a], radii[b], &forces[b]);
                 let ub = self.pair_apply(mu, &r, radii[a], radii[b], &forces[a]);
                 out[a] += ua;

@@ -227,8 +227,8 @@ vector_dispatch! {
 }
 
 /// Spheres per tile of the symmetric kernel: n/32, within these bounds (multiples of [`LANES`]).
-/// Tiles of 256 cost 3% less than 128 and 10% less than 64 serially (n = 4,096, this 2-core
-/// machine), but a round has only tiles/2 pairs to run in parallel: n/32 keeps 16 at n = 4,096.
+/// Larger tiles cost a little less serially (fewer tile edges), but a round has only tiles/2
+/// pairs of tiles to run in parallel: n/32 keeps 16 at n = 4,096.
 const MIN_TILE: usize = 128;
 /// See [`MIN_TILE`].
 const MAX_TILE: usize = 256;

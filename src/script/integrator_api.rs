@@ -1,5 +1,6 @@
-//! `euler(dt)`, `rk4(dt)`, `dopri5(rtol)`, `rosw(rtol)`: integrator choices as script values (type
-//! `Integrator`), one constructor per entry of the engine's method table.
+//! Integrator choices as script values (type `Integrator`): one constructor per entry of the
+//! engine's method table (`euler(dt)`, `rk4(dt)`, `dopri5(rtol)`, ...), and `stroboscopic(tol,
+//! inner)` with an inner method.
 
 use super::convert::{lift, number, ScriptResult};
 use super::docs::{doc_entry, Doc};
@@ -7,7 +8,7 @@ use crate::engine::integrators::METHODS;
 use crate::engine::IntegratorSpec;
 use rhai::{Dynamic, Engine};
 
-/// The accepted call forms, for messages: `euler(dt), rk4(dt), dopri5(rtol), rosw(rtol)`.
+/// The accepted call forms of the method table, for messages: `euler(dt), rk4(dt), ...`.
 pub fn call_forms() -> String {
     METHODS
         .iter()

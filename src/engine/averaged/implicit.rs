@@ -4,11 +4,10 @@
 //!
 //! A cluster is a connected set of swimmers whose bodies are within [`CONTACT_MARGIN_OF_RANGE`]
 //! ranges of the repulsion of one another. Its block is ∂(steric rates)/∂(R_H, N) of its swimmers
-//! by forward differences of the force law as it is: zero for a pair not yet in range. (Carrying
-//! the law on past the range, to make a contact about to form implicit already, was measured
-//! and dropped: a W-method keeps its order with any matrix, but its error constants grow with
-//! the matrix's distance from the Jacobian, and the steps of the swimmers concerned shrank
-//! tenfold.) The far field stays explicit.
+//! by forward differences of the force law as it is: zero for a pair not yet in range (a
+//! W-method keeps its order with any matrix, but its error constants grow with the matrix's
+//! distance from the Jacobian, so a block that carried the law on past the range would cost the
+//! swimmers about to touch their steps). The far field stays explicit.
 
 use super::{vec3, AveragedSystem, STATE_PER_SWIMMER};
 use crate::engine::integrators::GroupJacobian;

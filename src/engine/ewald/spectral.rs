@@ -106,7 +106,7 @@ impl std::fmt::Debug for SpectralEwald {
 /// Measured costs (ns per core) of the method's parts, for the choice of ξ: a real-space pair
 /// within r_c (erfc, exp), a pair scanned in the 27 cells around a sphere, a support point spread
 /// and gathered (three components), a grid point's share of one transform per log2 of the grid
-/// size (timed on the project's 2-core machine, 4,096 spheres at three splittings).
+/// size. Only their ratios matter: they pick ξ.
 const COST_PAIR: f64 = 60.0;
 const COST_SCAN: f64 = 15.0;
 const COST_SUPPORT: f64 = 6.0;
