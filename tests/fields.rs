@@ -206,8 +206,9 @@ fn aligned_swimmers_are_fully_polar_and_nematic() {
     );
 }
 
-/// A density and a polarization field written as VTK image data and read back with vtkio: the
-/// extent, origin and spacing (µm, f32) and every value (f64, exactly; density in 1/µm³).
+/// A density and a polarization field written as VTK image data and read back with vtkio: a
+/// grid of the cells' corners whose bounds are the box's faces (µm, f32), one value per cell as
+/// cell data (f64, exactly; density in 1/µm³), under plain names.
 #[test]
 fn a_field_written_as_vtk_reads_back() {
     use vtkio::model::{Attribute, DataSet, Extent, Piece};
@@ -251,17 +252,23 @@ fn a_field_written_as_vtk_reads_back() {
         else {
             panic!("not image data");
         };
-        assert_eq!(extent, Extent::Ranges([0..=5, 0..=4, 0..=3]));
+        assert_eq!(extent, Extent::Ranges([0..=6, 0..=5, 0..=4]));
+        let cells = [6.0, 5.0, 4.0];
         for k in 0..3 {
-            assert_eq!(origin[k], (f.origin[k] * 1e6) as f32);
+            // f32 in the file: the box's faces at ±150 µm to f32's 7 digits.
+            let (lo, hi) = (origin[k] as f64, (origin[k] + cells[k] * spacing[k]) as f64);
+            assert!((lo + 0.5 * l * 1e6).abs() < 1e-4, "axis {k}: from {lo} µm");
+            assert!((hi - 0.5 * l * 1e6).abs() < 1e-4, "axis {k}: to {hi} µm");
             assert_eq!(spacing[k], (f.spacing[k] * 1e6) as f32);
         }
         let Piece::Inline(piece) = &pieces[0] else {
             panic!("not inline");
         };
-        let Attribute::DataArray(array) = &piece.data.point[0] else {
+        assert!(piece.data.point.is_empty(), "values are cell data");
+        let Attribute::DataArray(array) = &piece.data.cell[0] else {
             panic!("no data array");
         };
+        assert_eq!(array.name, kind.name(), "a plain name");
         let got: Vec<f64> = array.data.clone().cast_into().unwrap();
         let want: Vec<f64> = f.values.iter().map(|v| v / per).collect();
         assert_eq!(got, want, "{}", kind.name());

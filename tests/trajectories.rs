@@ -76,7 +76,8 @@ fn ase_reads_the_extended_xyz_back() {
             "import ase.io, json, sys\n\
              frames = ase.io.read(sys.argv[1], index=':')\n\
              print(json.dumps([{'pos': f.positions.tolist(), 'radius': f.arrays['radius'].tolist(), \
-             'swimmer': f.arrays['swimmer'].tolist(), 'N': f.arrays['N'].tolist(), 'time': f.info['Time']} \
+             'swimmer': f.arrays['swimmer'].tolist(), 'sphere': f.arrays['sphere'].tolist(), \
+             'N': f.arrays['dipoles'].tolist(), 'symbols': f.get_chemical_symbols(), 'time': f.info['Time']} \
              for f in frames]))",
             path.to_str().unwrap(),
         ])
@@ -107,6 +108,9 @@ fn ase_reads_the_extended_xyz_back() {
         assert_eq!(got, p.to_vec(), "sphere {k}");
         assert_eq!(last["radius"][k].as_f64().unwrap(), *r);
         assert_eq!(last["swimmer"][k].as_u64().unwrap() as usize, *i);
+        assert_eq!(last["sphere"][k].as_u64().unwrap() as usize, k % 2 + 1);
+        // Z = 0 makes every sphere ASE's dummy atom X, whatever its species name.
+        assert_eq!(last["symbols"][k], "X");
         let n = scene.dir(*i).unwrap();
         for c in 0..3 {
             assert!((last["N"][k][c].as_f64().unwrap() - n[c]).abs() < 1e-9);
@@ -161,6 +165,18 @@ fn a_bad_trajectory_name_is_refused() {
     assert!(e.contains("must end in .xyz") && e.contains(".pvd"), "{e}");
 }
 
+/// The columns a frame's comment line declares: the sum of the counts in `Properties=name:type:count:...`.
+fn columns_declared(comment: &str) -> Option<usize> {
+    let spec = comment.split("Properties=").nth(1)?.split(' ').next()?;
+    let fields: Vec<&str> = spec.split(':').collect();
+    fields.len().is_multiple_of(3).then(|| {
+        fields
+            .chunks(3)
+            .filter_map(|f| f[2].parse::<usize>().ok())
+            .sum()
+    })
+}
+
 /// Frames in an XYZ file, and whether it ends exactly after a whole frame.
 fn whole_frames(text: &str) -> (usize, bool) {
     let lines: Vec<&str> = text.lines().collect();
@@ -172,13 +188,11 @@ fn whole_frames(text: &str) -> (usize, bool) {
         if i + 2 + n > lines.len() {
             return (frames, false);
         }
-        assert!(
-            lines[i + 1].contains("Properties="),
-            "comment line of frame {frames}"
-        );
+        let columns = columns_declared(lines[i + 1])
+            .unwrap_or_else(|| panic!("no Properties= on the comment line of frame {frames}"));
         assert!(lines[i + 2..i + 2 + n]
             .iter()
-            .all(|l| l.split(' ').count() == 10));
+            .all(|l| l.split(' ').count() == columns));
         i += 2 + n;
         frames += 1;
     }

@@ -385,8 +385,11 @@ impl Field {
         })
     }
 
-    /// The field as VTK image data (ParaView's `.vti`): lengths in µm like the trajectories,
-    /// values as point data at the cell centres ("density [1/um^3]", "polarization", "Q").
+    /// The field as VTK image data (ParaView's `.vti`): lengths in µm like the trajectories, one
+    /// value per cell as cell data on a grid of the cells' corners (in a box its bounds are the
+    /// box's faces, so fields and trajectories overlay), named `density` (1/µm³), `polarization`
+    /// (vectors) or `Q` (tensors); the units are the file's field data (`length_unit`,
+    /// `density_unit`).
     pub fn to_vti(&self) -> Result<Vec<u8>> {
         use vtkio::model::{
             Attribute, Attributes, ByteOrder, DataArray, DataSet, Extent, ImageDataPiece, Piece,
@@ -394,23 +397,27 @@ impl Field {
         };
         const UM: f64 = 1e6;
         let n = self.grid;
-        let array = match self.kind {
-            FieldKind::Density => DataArray::scalars("density [1/um^3]", 1).with_data(
-                self.values
-                    .iter()
-                    .map(|v| v / UM.powi(3))
-                    .collect::<Vec<_>>(),
+        let (array, unit) = match self.kind {
+            FieldKind::Density => (
+                DataArray::scalars("density", 1).with_data(
+                    self.values
+                        .iter()
+                        .map(|v| v / UM.powi(3))
+                        .collect::<Vec<_>>(),
+                ),
+                ("density_unit", "1/um^3"),
             ),
-            FieldKind::Polarization => {
-                DataArray::vectors("polarization").with_data(self.values.clone())
-            }
-            FieldKind::Nematic => DataArray::tensors("Q").with_data(self.values.clone()),
+            FieldKind::Polarization => (
+                DataArray::vectors("polarization").with_data(self.values.clone()),
+                ("polarization_unit", "1"),
+            ),
+            FieldKind::Nematic => (
+                DataArray::tensors("Q").with_data(self.values.clone()),
+                ("Q_unit", "1"),
+            ),
         };
-        let extent = Extent::Ranges([
-            0..=(n[0] as i32 - 1),
-            0..=(n[1] as i32 - 1),
-            0..=(n[2] as i32 - 1),
-        ]);
+        let extent = Extent::Ranges([0..=(n[0] as i32), 0..=(n[1] as i32), 0..=(n[2] as i32)]);
+        let corner = |d: usize| self.origin[d] - 0.5 * self.spacing[d];
         let vtk = Vtk {
             version: Version::new_xml(1, 0),
             byte_order: ByteOrder::LittleEndian,
@@ -418,24 +425,19 @@ impl Field {
             file_path: None,
             data: DataSet::ImageData {
                 extent: extent.clone(),
-                origin: self.origin.map(|o| (o * UM) as f32),
+                origin: [0, 1, 2].map(|d| (corner(d) * UM) as f32),
                 spacing: self.spacing.map(|h| (h * UM) as f32),
                 meta: None,
                 pieces: vec![Piece::Inline(Box::new(ImageDataPiece {
                     extent,
                     data: Attributes {
-                        point: vec![Attribute::DataArray(array)],
-                        cell: Vec::new(),
+                        point: Vec::new(),
+                        cell: vec![Attribute::DataArray(array)],
                     },
                 }))],
             },
         };
-        let file = vtkio::xml::VTKFile::try_from(vtk)
-            .map_err(|e| invalid!("cannot make the VTK image: {e}"))?;
-        let mut bytes = Vec::new();
-        file.write(&mut bytes)
-            .map_err(|e| invalid!("cannot write the VTK image: {e}"))?;
-        Ok(bytes)
+        super::vtk::xml_with_units(vtk, &[("length_unit", "um"), unit], "the VTK image")
     }
 }
 

@@ -37,6 +37,7 @@ pub mod stepping;
 pub mod swimmer;
 pub mod thermal;
 pub mod trajectory;
+mod vtk;
 
 pub use backend::Backend;
 pub use contacts::{Contacts, Overlaps, Steric, StericBody, StericLaw};

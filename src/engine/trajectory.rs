@@ -2,13 +2,14 @@
 //! one particle per sphere, on a recorder's trigger.
 //!
 //! - Extended XYZ (`.xyz`; ASE, OVITO): one frame after another in one file. Positions and radii
-//!   in µm (the comment line says so: `length_unit=um`), with the swimmer index, the sphere (1:
-//!   the a1 sphere, 2: the a2 sphere) and the orientation N per particle, and the time in s.
+//!   in µm (the comment line says so: `length_unit=um`), with the species `a1` or `a2` (the
+//!   sphere's kind), the swimmer index, the sphere (1: the a1 sphere, 2: the a2 sphere), the
+//!   orientation N as `dipoles` and `Z` = 0 per particle, and the time in s.
 //!   Each frame is appended with one write the moment it is due, so a kill or Ctrl-C loses no
 //!   frame already written and never leaves half of one.
 //! - A ParaView series (`.pvd`): one VTK PolyData file (`.vtp`, written by the vtkio crate) per
 //!   frame in the folder `<name>_frames/` beside it, with the same data as point arrays (radius
-//!   and N for glyphs), and the `.pvd` collection listing every frame with its time. Each frame
+//!   and N, the active vectors, for glyphs) and the length unit as field data, and the `.pvd` collection listing every frame with its time. Each frame
 //!   costs the same however many came before: the `.vtp` is written under a temporary name in
 //!   the frames folder and renamed when whole (a frame's name only ever holds a whole frame),
 //!   then its entry and the collection's closing lines are written with one write over the old
@@ -260,22 +261,35 @@ impl Spheres {
             ),
             None => "pbc=\"F F F\"".to_string(),
         };
+        // The species names the sphere kind (a1, a2), so that viewers draw the two in two colours;
+        // Z = 0 is ASE's dummy atom, which lets ASE read names that are no element's. The
+        // orientation is `dipoles`: OVITO reads it as its "Dipole Orientation", ready for arrows.
         let _ = writeln!(
             out,
-            "{cell} Properties=species:S:1:pos:R:3:radius:R:1:swimmer:I:1:sphere:I:1:N:R:3 Time={time:?} time_unit=s length_unit=um"
+            "{cell} Properties=species:S:1:pos:R:3:radius:R:1:swimmer:I:1:sphere:I:1:dipoles:R:3:Z:I:1 Time={time:?} time_unit=s length_unit=um"
         );
         for k in 0..self.pos.len() {
             let (p, d) = (self.pos[k], self.dir[k]);
             let _ = writeln!(
                 out,
-                "X {:?} {:?} {:?} {:?} {} {} {:?} {:?} {:?}",
-                p[0], p[1], p[2], self.radius[k], self.swimmer[k], self.sphere[k], d[0], d[1], d[2]
+                "a{} {:?} {:?} {:?} {:?} {} {} {:?} {:?} {:?} 0",
+                self.sphere[k],
+                p[0],
+                p[1],
+                p[2],
+                self.radius[k],
+                self.swimmer[k],
+                self.sphere[k],
+                d[0],
+                d[1],
+                d[2]
             );
         }
         out
     }
 
-    /// One `.vtp` file: the spheres as vertices with point arrays radius, swimmer, sphere, N.
+    /// One `.vtp` file: the spheres as vertices with point arrays radius, swimmer, sphere, N (the
+    /// active vectors), and the length unit as field data.
     fn vtp(&self) -> Result<Vec<u8>> {
         use vtkio::model::{
             Attribute, Attributes, ByteOrder, DataArray, DataSet, PolyDataPiece, Version,
@@ -315,11 +329,6 @@ impl Spheres {
                 ..Default::default()
             }),
         };
-        let file = vtkio::xml::VTKFile::try_from(vtk)
-            .map_err(|e| invalid!("cannot make a VTK frame: {e}"))?;
-        let mut bytes = Vec::new();
-        file.write(&mut bytes)
-            .map_err(|e| invalid!("cannot write a VTK frame: {e}"))?;
-        Ok(bytes)
+        super::vtk::xml_with_units(vtk, &[("length_unit", "um")], "a VTK frame")
     }
 }
