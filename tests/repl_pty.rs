@@ -89,7 +89,12 @@ fn transcript_of_a_session() {
 #[test]
 fn long_runs_show_a_progress_bar() {
     let mut s = start();
-    step(&mut s, "let s = scene(); s.add(dumbbell());", "");
+    // The direct default step: auto(tol) would average 3,000 periods in a blink.
+    step(
+        &mut s,
+        "let s = scene(); s.add(dumbbell()); s.integrator = rk4(5e-6);",
+        "",
+    );
     s.send_line("s.run_periods(3000); s.count").unwrap();
     s.expect("periods/s").expect("a progress bar");
     s.expect("=> 1").unwrap();

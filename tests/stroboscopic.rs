@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use swimlab::engine::integrators::{OdeSystem, Rk4, Stats, Stepper, Stroboscopic};
 use swimlab::engine::{
-    Dumbbell, EngineError, IntegratorSpec, Observable, Scene, Simulation, Trigger,
+    Dumbbell, EngineError, IntegratorSpec, Model, Observable, Scene, Simulation, Trigger,
 };
 
 /// x' = −εx + A cos(2πt) in component 0 (the rest constant): a slow decay under a fast forcing of
@@ -99,13 +99,13 @@ fn mean_x(s: &Scene) -> f64 {
 
 #[test]
 fn the_transient_is_the_direct_run() {
-    // With the default RK4 as the inner integrator, the first period (the spring settling from
+    // With RK4 at the direct default step as the inner integrator, the first period (the spring settling from
     // L(0)) is integrated directly: the row at T is the direct run's, to the bit.
     let dt = mirror_inwards(10.0, true).default_micro_step();
     let spec =
         IntegratorSpec::stroboscopic_with(1e-5, Some(IntegratorSpec::rk4(dt).unwrap())).unwrap();
     let mut a = fig1_pair(Some(spec));
-    let mut b = fig1_pair(None);
+    let mut b = fig1_pair(Some(IntegratorSpec::rk4(dt).unwrap()));
     for s in [&mut a, &mut b] {
         s.record(
             vec![Observable::CenterH(0), Observable::Length(1)],
@@ -320,6 +320,37 @@ fn close_pairs_keep_the_tolerance() {
             );
         }
     }
+}
+
+#[test]
+fn auto_is_the_default_of_the_spring_and_rigid_models_and_says_so() {
+    let mut s = mirror_inwards(10.0, true);
+    let auto = IntegratorSpec::auto(swimlab::engine::DEFAULT_AUTO_TOL).unwrap();
+    assert_eq!(s.integrator(), auto);
+    // Its inner RK4 steps at exactly the direct step 0.8/rate: runs it cannot average are the
+    // direct runs, bit for bit.
+    let direct = IntegratorSpec::rk4(s.default_micro_step()).unwrap();
+    assert_eq!(
+        s.stroboscopic_inner(swimlab::engine::DEFAULT_AUTO_TOL),
+        direct
+    );
+    assert!(s.integrator_info().unwrap().starts_with(&format!(
+        "auto(1.1e-5) (the micro model's default) runs stroboscopic(1.1e-5, {direct})"
+    )));
+    s.set_model(Model::Rigid);
+    assert_eq!(s.integrator(), auto);
+    assert!(s
+        .integrator_info()
+        .unwrap()
+        .contains("runs stroboscopic(1.1e-5, dopri5(1e-7))"));
+    // The gpu backend steps explicit methods only: there the spring model's default stays RK4 at
+    // 0.8/rate; thermal noise keeps Euler-Maruyama.
+    s.set_model(Model::Micro);
+    s.set_backend(swimlab::engine::Backend::Gpu);
+    assert_eq!(s.integrator(), direct);
+    s.set_backend(swimlab::engine::Backend::Cpu);
+    s.set_temperature(300.0).unwrap();
+    assert!(matches!(s.integrator(), IntegratorSpec::Euler { .. }));
 }
 
 #[test]

@@ -47,7 +47,7 @@ pub use mobility::Mobility;
 pub use model::{Coefficients, Model};
 pub use observable::Observable;
 pub use recorder::{Recorder, Trigger};
-pub use scene::Scene;
+pub use scene::{Scene, DEFAULT_AUTO_TOL};
 pub use simulation::Simulation;
 pub use stepping::RunControl;
 pub use swimmer::Dumbbell;

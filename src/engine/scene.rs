@@ -42,6 +42,13 @@ pub const DEFAULT_NOISY_STEP_TIMES_RATE: f64 = 0.1;
 pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
 /// Default tolerance of the rigid-stroke model's adaptive integrator (README, "work-precision").
 pub const DEFAULT_RIGID_RTOL: f64 = 1e-7;
+/// The tolerance of `auto(tol)`, the default of the spring and rigid-stroke models without noise,
+/// relative to the drift: ten times [`dynamics::RK4_DEFAULT_DRIFT_ERROR`], so that auto's inner RK4,
+/// which steps where its drift error is a tenth of tol, steps at exactly the direct step
+/// 0.8/rate. Runs that cannot be averaged are then the direct RK4 runs bit for bit; a larger
+/// inner step errs on the drift of pairs far apart (a swimmer's own stroke error does not shrink
+/// with the interaction; README, "Long runs").
+pub const DEFAULT_AUTO_TOL: f64 = 1.1e-5;
 /// The largest denominator q of a ratio ωᵢ/ω₀ = p/q that [`Scene::common_period`] recognises.
 pub const MAX_PERIOD_DENOMINATOR: u64 = 64;
 /// The longest common period [`Scene::common_period`] accepts, in periods of the slowest stroke.
@@ -743,26 +750,29 @@ impl Scene {
 
     /// The model's default integrator for the swimmers of this scene.
     ///
-    /// Microscopic: RK4 at dt = 0.8/rate of the stiffest spring (see
-    /// [`DEFAULT_MICRO_STEP_TIMES_RATE`]), but at most 1/200 of the shortest period. Averaged: for a
-    /// suspension ([`Scene::is_suspension`]) `suspension(tol)` at [`DEFAULT_SUSPENSION_TOL`], else
-    /// dopri5, whose steps grow to a good fraction of a period (the averaged model is not stiff).
+    /// Spring and rigid-stroke models: `auto(tol)` at [`DEFAULT_AUTO_TOL`] (stroboscopic averaging
+    /// over a common period, its inner method directly where averaging cannot help). On the gpu
+    /// backend, which steps the explicit methods only, the spring model keeps RK4 at dt = 0.8/rate
+    /// of the stiffest spring (see [`DEFAULT_MICRO_STEP_TIMES_RATE`]), at most 1/200 of the
+    /// shortest period. Averaged: for a suspension ([`Scene::is_suspension`]) `suspension(tol)` at
+    /// [`DEFAULT_SUSPENSION_TOL`], else dopri5, whose steps grow to a good fraction of a period
+    /// (the averaged model is not stiff).
     pub fn default_integrator(&self) -> IntegratorSpec {
         if self.thermal.is_on() {
             return self.default_noisy_integrator();
         }
         match self.model {
-            Model::Micro => IntegratorSpec::Rk4 {
+            Model::Micro if self.backend == Backend::Gpu => IntegratorSpec::Rk4 {
                 dt: self.default_micro_step(),
+            },
+            Model::Micro | Model::Rigid => IntegratorSpec::Auto {
+                tol: DEFAULT_AUTO_TOL,
             },
             Model::Averaged if self.is_suspension() => IntegratorSpec::Suspension {
                 tol: DEFAULT_SUSPENSION_TOL,
             },
             Model::Averaged => IntegratorSpec::Dopri5 {
                 rtol: DEFAULT_AVERAGED_RTOL,
-            },
-            Model::Rigid => IntegratorSpec::Dopri5 {
-                rtol: DEFAULT_RIGID_RTOL,
             },
         }
     }

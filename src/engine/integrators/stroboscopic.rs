@@ -481,14 +481,21 @@ impl Stepper for Stroboscopic {
                 t_new
             }
         };
-        // Direct: the transient, a short remainder, and the last fraction of a period.
+        // Direct: the transient a period at a time; a run or remainder too short for a macro step
+        // (and the last fraction of a period) in one go to its end, as the inner method alone
+        // would step it.
         if self.pending_transient > 0 || whole < min_macro {
-            let target = if whole >= 1 { snap(t + period) } else { t_end };
+            let transient = self.pending_transient > 0 && whole >= 1;
+            let (target, periods) = if transient {
+                (snap(t + period), 1)
+            } else {
+                (t_end, whole)
+            };
             let mut trial = y.to_vec();
             let t_new = self.direct(sys, t, &mut trial, target, stats)?;
-            if whole >= 1 {
-                stats.micro_periods += 1;
-                self.pending_transient = self.pending_transient.saturating_sub(1);
+            stats.micro_periods += periods;
+            if transient {
+                self.pending_transient -= 1;
             }
             y.copy_from_slice(&trial);
             self.slope = None;

@@ -337,7 +337,12 @@ impl Scene {
         Ok(match spec {
             IntegratorSpec::Auto { tol } => {
                 let (chosen, why) = self.auto_choice(tol)?;
-                format!("{spec} runs {chosen}: {why}")
+                let default = if self.integrator_is_default() {
+                    format!(" (the {} model's default)", self.model.name())
+                } else {
+                    String::new()
+                };
+                format!("{spec}{default} runs {chosen}: {why}")
             }
             IntegratorSpec::Suspension { .. } if self.integrator_is_default() => format!(
                 "{spec}: the {} model's default for a suspension (a box, a cutoff, steric repulsion or at least {} swimmers): each swimmer's error held to tol of its own displacement over a step, steric contacts implicit, a few fast swimmers (a contact, a close pair) stepped apart with steps of their own",
