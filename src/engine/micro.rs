@@ -26,6 +26,10 @@ pub struct MicroSystem {
     thermal: Option<Thermal>,
     /// Sphere displacements of one step's noise (scratch, 3 per sphere).
     kicks: Vec<f64>,
+    /// The rest lengths L(t) at the time `rest_t`: stages share times (RK4's middle two, a step's
+    /// end and the next one's start), and the sine is a sizeable part of a small scene's rates.
+    rest: Vec<f64>,
+    rest_t: f64,
 }
 
 impl MicroSystem {
@@ -43,6 +47,18 @@ impl MicroSystem {
             spheres: Spheres::new(swimmers, mu, mobility, contacts),
             thermal: None,
             kicks: Vec::new(),
+            rest: swimmers.iter().map(|d| d.rest_length(0.0)).collect(),
+            rest_t: 0.0,
+        }
+    }
+
+    /// Bring the rest lengths to time `t`.
+    fn rest_at(&mut self, t: f64) {
+        if t.to_bits() != self.rest_t.to_bits() {
+            for (l, d) in self.rest.iter_mut().zip(&self.swimmers) {
+                *l = d.rest_length(t);
+            }
+            self.rest_t = t;
         }
     }
 
@@ -122,13 +138,13 @@ impl OdeSystem for MicroSystem {
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.rest_at(t);
         self.place(y);
-        let swimmers = &self.swimmers;
+        let (swimmers, rest) = (&self.swimmers, &self.rest);
         self.spheres.interact(|s| {
-            let d = &swimmers[s];
             let b = vec3(y, STATE_PER_SWIMMER * s + 3);
             let len = b.norm();
-            d.k0 * (len - d.rest_length(t)) / len * b
+            swimmers[s].k0 * (len - rest[s]) / len * b
         });
         let sp = &self.spheres;
         for (s, d) in self.swimmers.iter().enumerate() {
@@ -265,9 +281,10 @@ impl OdeSystem for MicroSystem {
     /// such a deviation is a numerical instability (explicit steps above the stability limit grow
     /// the spring mode geometrically), never physics.
     fn check(&mut self, t: f64, y: &[f64]) -> Result<(), Problem> {
+        self.rest_at(t);
         for (s, d) in self.swimmers.iter().enumerate() {
             let len = vec3(y, STATE_PER_SWIMMER * s + 3).norm();
-            let dev = len - d.rest_length(t);
+            let dev = len - self.rest[s];
             if dev.abs() > 0.5 * d.ell {
                 return Err(Problem {
                     swimmer: Some(s),
