@@ -3,8 +3,9 @@
 
 use nalgebra::Vector3;
 use swimlab::bench::pairs::lattice;
+use swimlab::engine::gaps::min_gap;
 use swimlab::engine::pairs::{
-    interaction_velocities, min_gap, row_velocities, symmetric_velocities, tile_rounds, SoaSpheres,
+    interaction_velocities, row_velocities, symmetric_velocities, tile_rounds, SoaSpheres,
     SYMMETRIC_SPHERES,
 };
 use swimlab::engine::Mobility;
@@ -185,7 +186,7 @@ fn overlapping_spheres_take_the_overlap_form_in_the_fast_kernels() {
 // ties included, and with none.
 #[test]
 fn closest_overlap_through_cell_lists_is_min_gaps_answer() {
-    use swimlab::engine::pairs::{closest_overlap, CELL_LIST_SPHERES};
+    use swimlab::engine::gaps::{closest_overlap, CELL_LIST_SPHERES};
     let n = 3000;
     assert!(n >= CELL_LIST_SPHERES);
     let clear = lattice(n);

@@ -414,7 +414,8 @@ fn periodic_cell_lists_give_the_all_pairs_rates() {
 /// (cells of twice the mean spacing) gives the brute-force smallest gap.
 #[test]
 fn the_overlap_guard_sees_across_the_faces() {
-    use swimlab::engine::pairs::{closest_overlap, min_gap, SoaSpheres};
+    use swimlab::engine::gaps::{closest_overlap, min_gap};
+    use swimlab::engine::pairs::SoaSpheres;
     let b = PeriodicBox::new([60e-6, 50e-6, 55e-6]).unwrap();
     let mut rng = Rng::new(0x6a09e667f3bcc909);
     let n = 2000;

@@ -256,7 +256,7 @@ impl Steric {
         };
         let reach_max = self.range + 2.0 * radii.iter().copied().fold(0.0, f64::max);
         let fits = periodic.is_none_or(|b| reach_max <= 0.5 * b.shortest());
-        if pos.len() >= super::pairs::CELL_LIST_SPHERES && fits {
+        if pos.len() >= super::gaps::CELL_LIST_SPHERES && fits {
             return self.add_forces_by_cells(pos, radii, periodic, forces, parallel);
         }
         if parallel {
@@ -421,7 +421,7 @@ impl Steric {
 
     /// [`Steric::add_forces`] between rods: the force on a rod at fraction s along it goes
     /// (1 − s) to its first sphere and s to its second, which carries its force and torque about
-    /// any point. Each swimmer sums its partners in index order; from [`super::pairs::CELL_LIST_SPHERES`]
+    /// any point. Each swimmer sums its partners in index order; from [`super::gaps::CELL_LIST_SPHERES`]
     /// spheres the partners come from cell lists of the midpoints (side: range + twice the
     /// largest radius + the longest rod), bitwise the same forces.
     fn add_rod_forces(
@@ -439,7 +439,7 @@ impl Steric {
         let reach_max = self.range + 2.0 * radii.iter().copied().fold(0.0, f64::max) + longest;
         let fits = periodic.is_none_or(|b| reach_max <= 0.5 * b.shortest());
         let grid =
-            (pos.len() >= super::pairs::CELL_LIST_SPHERES && fits && reach_max > 0.0).then(|| {
+            (pos.len() >= super::gaps::CELL_LIST_SPHERES && fits && reach_max > 0.0).then(|| {
                 let mid = |d: usize| -> Vec<f64> {
                     (0..swimmers)
                         .map(|k| 0.5 * (pos[2 * k][d] + pos[2 * k + 1][d]))

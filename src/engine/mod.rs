@@ -17,6 +17,7 @@ pub mod error;
 pub mod ewald;
 pub mod fields;
 pub mod files;
+pub mod gaps;
 pub mod gpu;
 pub mod integrators;
 pub mod micro;

@@ -225,7 +225,7 @@ impl Spheres {
         if self.pos.len() >= FAST_KERNEL_SPHERES {
             self.fill_soa();
             let parallel = self.pos.len() >= PARALLEL_SPHERES;
-            return pairs::closest_overlap(&self.soa, &self.radii, parallel)
+            return super::gaps::closest_overlap(&self.soa, &self.radii, parallel)
                 .map(|(gap, a, b)| overlap_problem(gap, a, b));
         }
         let (pos, radii, periodic) = (&self.pos, &self.radii, self.periodic());

@@ -801,7 +801,7 @@ impl OdeSystem for AveragedSystem {
         for (i, p) in self.sphere_pos.iter().enumerate() {
             (g.x[i], g.y[i], g.z[i]) = (p.x, p.y, p.z);
         }
-        match super::pairs::closest_overlap(g, &self.radii, parallel) {
+        match super::gaps::closest_overlap(g, &self.radii, parallel) {
             Some((gap, a, b)) => Err(super::spheres::overlap_problem(gap, a, b)),
             None => Ok(()),
         }

@@ -310,6 +310,6 @@ impl Scene {
                 radii.push(r);
             }
         }
-        crate::engine::pairs::min_gap(&soa, &radii, n >= 256)
+        crate::engine::gaps::min_gap(&soa, &radii, n >= 256)
     }
 }
