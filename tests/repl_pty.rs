@@ -89,10 +89,10 @@ fn transcript_of_a_session() {
 #[test]
 fn long_runs_show_a_progress_bar() {
     let mut s = start();
-    // The direct default step: auto(tol) would average 3,000 periods in a blink.
+    // The direct step: the default auto(tol) would average 3,000 periods in a blink.
     step(
         &mut s,
-        "let s = scene(); s.add(dumbbell()); s.integrator = rk4(5e-6);",
+        "let s = scene(); s.add(dumbbell()); s.integrator = rk4(s.direct_step);",
         "",
     );
     s.send_line("s.run_periods(3000); s.count").unwrap();

@@ -57,19 +57,27 @@ fn min_gap_all_pairs(s: &SoaSpheres, radii: &[f64], parallel: bool) -> Option<(f
         }
         best
     };
-    let pick = |a: Option<(f64, usize, usize)>, b: Option<(f64, usize, usize)>| match (a, b) {
-        (Some(x), Some(y)) => Some(if y.0 < x.0 || (y.0 == x.0 && y.1 < x.1) {
+    if parallel {
+        (0..n).into_par_iter().map(row).reduce(|| None, earlier)
+    } else {
+        (0..n).map(row).fold(None, earlier)
+    }
+}
+
+/// Of two pairs (gap, i, j), the one of smaller gap, then smaller i, then smaller j; a NaN gap
+/// never wins over the pair already held.
+fn earlier(
+    a: Option<(f64, usize, usize)>,
+    b: Option<(f64, usize, usize)>,
+) -> Option<(f64, usize, usize)> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(if (y.0, y.1, y.2) < (x.0, x.1, x.2) {
             y
         } else {
             x
         }),
         (x, None) => x,
         (None, y) => y,
-    };
-    if parallel {
-        (0..n).into_par_iter().map(row).reduce(|| None, pick)
-    } else {
-        (0..n).map(row).fold(None, pick)
     }
 }
 
@@ -112,13 +120,6 @@ fn closest_in_cells(
         side,
         s.periodic.as_ref(),
     );
-    let first = |a: (f64, usize, usize), b: (f64, usize, usize)| {
-        if (b.0, b.1, b.2) < (a.0, a.1, a.2) {
-            b
-        } else {
-            a
-        }
-    };
     let row = |i: usize| -> Option<(f64, usize, usize)> {
         let mut runs = Vec::with_capacity(27);
         grid.neighbour_runs(s.x[i], s.y[i], s.z[i], &mut runs);
@@ -132,20 +133,15 @@ fn closest_in_cells(
                 let (rx, ry, rz) = s.delta(i, j);
                 let gap = (rx * rx + ry * ry + rz * rz).sqrt() - radii[i] - radii[j];
                 if keep(gap) {
-                    best = Some(best.map_or((gap, i, j), |x| first(x, (gap, i, j))));
+                    best = earlier(best, Some((gap, i, j)));
                 }
             }
         }
         best
     };
-    let pick = |a: Option<(f64, usize, usize)>, b: Option<(f64, usize, usize)>| match (a, b) {
-        (Some(x), Some(y)) => Some(first(x, y)),
-        (x, None) => x,
-        (None, y) => y,
-    };
     if parallel {
-        (0..n).into_par_iter().map(row).reduce(|| None, pick)
+        (0..n).into_par_iter().map(row).reduce(|| None, earlier)
     } else {
-        (0..n).map(row).fold(None, pick)
+        (0..n).map(row).fold(None, earlier)
     }
 }

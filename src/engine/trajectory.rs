@@ -9,9 +9,10 @@
 //!   frame already written and never leaves half of one.
 //! - A ParaView series (`.pvd`): one VTK PolyData file (`.vtp`, written by the vtkio crate) per
 //!   frame in the folder `<name>_frames/` beside it, with the same data as point arrays (radius
-//!   and N, the active vectors, for glyphs) and the length unit as field data, and the `.pvd` collection listing every frame with its time. Each frame
-//!   costs the same however many came before: the `.vtp` is written under a temporary name in
-//!   the frames folder and renamed when whole (a frame's name only ever holds a whole frame),
+//!   and N, the active vectors, for glyphs) and the length unit as field data, and the `.pvd`
+//!   collection listing every frame with its time. Each frame costs the same however many came
+//!   before: the `.vtp` is written under a temporary name in the frames folder and renamed when
+//!   whole (a frame's name only ever holds a whole frame),
 //!   then its entry and the collection's closing lines are written with one write over the old
 //!   closing lines. A kill leaves a `.pvd` that lists every whole frame and ends in its closing
 //!   lines, and at most the temporary file of the frame being written, inside the frames

@@ -21,9 +21,6 @@ pub(crate) fn xml_with_units(
     let mut bytes = Vec::new();
     file.write(&mut bytes)
         .map_err(|e| invalid!("cannot write {what}: {e}"))?;
-    if units.is_empty() {
-        return Ok(bytes);
-    }
     let at = find(&bytes, b"<Piece")
         .ok_or_else(|| invalid!("cannot write {what}: the dataset has no piece"))?;
     let mut out = Vec::with_capacity(bytes.len() + 128 * units.len());

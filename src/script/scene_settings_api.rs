@@ -1,6 +1,7 @@
 //! A scene's settings in scripts: `s.mu`, the named choices (`s.model`, `s.mobility`, `s.backend`,
 //! `s.coefficients`, `s.overlaps`, each read from its engine table), `s.steric`, `s.cutoff`,
-//! `s.integrator`, and the read-only `time`, `count`, `period`, `stiff_rate`, `backend_info`.
+//! `s.integrator`, and the read-only `time`, `count`, `period`, `stiff_rate`, `direct_step`,
+//! `backend_info`.
 
 use super::convert::{describe, lift, number, script_error, unknown_choice, ScriptResult};
 use super::docs::{doc_entry, Doc};
@@ -191,6 +192,9 @@ pub fn register(engine: &mut Engine) {
         .register_get("count", |s: &mut SceneHandle| s.borrow().count() as INT)
         .register_get("period", |s: &mut SceneHandle| s.with(|sc| sc.period()))
         .register_get("stiff_rate", |s: &mut SceneHandle| s.borrow().stiff_rate())
+        .register_get("direct_step", |s: &mut SceneHandle| {
+            s.borrow().default_micro_step()
+        })
         .register_get("mu", |s: &mut SceneHandle| s.borrow().mu())
         .register_set(
             "mu",
@@ -295,7 +299,8 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("noise_root", "thermal", "s.noise_root -> string\ns.noise_root = \"auto\" | \"cholesky\" | \"lanczos\"", "How the square root of the mobility is applied to the noise: the dense Cholesky factor (exact, O(N^3) a step), the Lanczos iteration on the pair kernel (O(N^2) a product, to s.lanczos_tol), or \"auto\": Cholesky up to 48 spheres, Lanczos above (the crossover measured by examples/noise_roots.rs: 45-50 spheres).", "let s = scene(); s.noise_root = \"lanczos\"; print(s.noise_root);"),
     doc_entry!("lanczos_tol", "thermal", "s.lanczos_tol -> float\ns.lanczos_tol = tol", "Tolerance of the Lanczos square root: it stops when sqrt(M) xi changes by less than tol of its size from one iteration to the next (default 1e-6).", "let s = scene(); s.lanczos_tol = 1e-8; print(s.lanczos_tol);"),
     doc_entry!("mu", "numerics", "s.mu -> float\ns.mu = x", "Viscosity (Pa s).", "let s = scene(); s.mu = 2e-3; print(s.mu);"),
-    doc_entry!("stiff_rate", "numerics", "s.stiff_rate -> float", "The largest spring relaxation rate k0 (1/gamma1 + 1/gamma2) (1/s); explicit steps need dt below ~2.8/rate.", "let s = scene(); s.add(dumbbell()); print(s.stiff_rate);"),
+doc_entry!("direct_step", "numerics", "s.direct_step -> float", "The spring model's direct RK4 step (s): 0.8 / s.stiff_rate, at most 1/200 of the shortest period. The default auto(tol) steps at it where it cannot average (and samples with it); the gpu backend's default is rk4 at it. rk4(s.direct_step) runs a scene directly, without averaging.", "let s = scene(); s.add(dumbbell()); s.integrator = rk4(s.direct_step); print(s.integrator);"),
+        doc_entry!("stiff_rate", "numerics", "s.stiff_rate -> float", "The largest spring relaxation rate k0 (1/gamma1 + 1/gamma2) (1/s); explicit steps need dt below ~2.8/rate.", "let s = scene(); s.add(dumbbell()); print(s.stiff_rate);"),
     doc_entry!("time", "running", "s.time -> float", "Current time (s).", "let s = scene(); print(s.time);"),
     doc_entry!("period", "running", "s.period -> float", "The common stroke period (s).", "let s = scene(); s.add(dumbbell()); print(s.period);"),
     doc_entry!("count", "running", "s.count -> int", "Number of swimmers.", "let s = scene(); print(s.count);"),

@@ -142,14 +142,19 @@ impl Scene {
         self.integrator = spec;
     }
 
-    /// The common stroke period 2π/ω; an error if the swimmers' ω differ or there are none.
-    pub fn period(&self) -> Result<f64> {
-        let first = self.swimmers.first().ok_or_else(|| {
+    /// Swimmer 0, whose stroke the periods are measured against; an error without swimmers.
+    fn first_swimmer(&self) -> Result<&Dumbbell> {
+        self.swimmers.first().ok_or_else(|| {
             unsupported(
                 "the scene has no swimmers, so no period",
                 &[Setting::AddSwimmer],
             )
-        })?;
+        })
+    }
+
+    /// The common stroke period 2π/ω; an error if the swimmers' ω differ or there are none.
+    pub fn period(&self) -> Result<f64> {
+        let first = self.first_swimmer()?;
         if let Some((i, d)) = self
             .swimmers
             .iter()
@@ -169,12 +174,7 @@ impl Scene {
     /// commensurate (every ratio ωᵢ/ω₀ a fraction p/q with q ≤ [`MAX_PERIOD_DENOMINATOR`], to 1e-12),
     /// the least common multiple of the periods, if at most [`MAX_COMMON_PERIODS`] of the longest.
     pub fn common_period(&self) -> Result<f64> {
-        let first = self.swimmers.first().ok_or_else(|| {
-            unsupported(
-                "the scene has no swimmers, so no period",
-                &[Setting::AddSwimmer],
-            )
-        })?;
+        let first = self.first_swimmer()?;
         let w0 = first.omega;
         let mut q_lcm: u64 = 1;
         let mut fractions = Vec::with_capacity(self.swimmers.len());
