@@ -53,11 +53,13 @@ impl Mobility {
     /// Oseen has no finite size and keeps its point-force form at every distance.
     #[inline]
     pub fn pair_coefficients(self, mu: f64, d: f64, ai: f64, aj: f64) -> (f64, f64) {
-        let oseen = 1.0 / (8.0 * PI * mu * d);
+        // One division by d; the constants in μ are hoisted out of callers' loops.
+        let inv_d = 1.0 / d;
+        let oseen = inv_d * (1.0 / (8.0 * PI * mu));
         match self {
             Mobility::Oseen => (oseen, oseen),
             Mobility::Rpy if d > ai + aj => {
-                let f = (ai * ai + aj * aj) / (24.0 * PI * mu * d * d * d);
+                let f = (ai * ai + aj * aj) * (inv_d * inv_d) * oseen * (1.0 / 3.0);
                 (oseen + f, oseen - 3.0 * f)
             }
             Mobility::Rpy if d <= (ai - aj).abs() => (self_mobility(mu, ai.max(aj)), 0.0),
@@ -73,6 +75,16 @@ impl Mobility {
         }
     }
 
+    /// The pair block H_αβ = c_I I + c r r for separation `r` = x_α − x_β (α ≠ β) of spheres of
+    /// radii `ai`, `aj`: (c_I, c = c_rr/|r|²), the form every product with the block uses.
+    #[inline]
+    pub fn pair_block(self, mu: f64, r: &Vector3<f64>, ai: f64, aj: f64) -> (f64, f64) {
+        let d2 = r.norm_squared();
+        let (ci, crr) = self.pair_coefficients(mu, d2.sqrt(), ai, aj);
+        // c_rr vanishes where one sphere holds the other, the coincident pair included.
+        (ci, if crr == 0.0 { 0.0 } else { crr / d2 })
+    }
+
     /// H_αβ F for spheres of radii `ai`, `aj` at separation `r` = x_α − x_β (α ≠ β).
     #[inline]
     pub fn pair_apply(
@@ -83,23 +95,14 @@ impl Mobility {
         aj: f64,
         f: &Vector3<f64>,
     ) -> Vector3<f64> {
-        let d = r.norm();
-        let (ci, crr) = self.pair_coefficients(mu, d, ai, aj);
-        if crr == 0.0 {
-            return ci * f;
-        }
-        ci * f + r * (crr * r.dot(f) / (d * d))
+        let (ci, c) = self.pair_block(mu, r, ai, aj);
+        ci * f + r * (c * r.dot(f))
     }
 
     /// The 3×3 block H_αβ (α ≠ β) as a matrix.
     pub fn pair_tensor(self, mu: f64, r: &Vector3<f64>, ai: f64, aj: f64) -> Matrix3<f64> {
-        let d = r.norm();
-        let (ci, crr) = self.pair_coefficients(mu, d, ai, aj);
-        let mut h = ci * Matrix3::identity();
-        if crr != 0.0 {
-            h += crr * r * r.transpose() / (d * d);
-        }
-        h
+        let (ci, c) = self.pair_block(mu, r, ai, aj);
+        ci * Matrix3::identity() + c * r * r.transpose()
     }
 
     /// The full 3N×3N mobility matrix including self terms (for tests and small systems).
@@ -133,13 +136,12 @@ impl Mobility {
         let n = pos.len();
         for a in 0..n {
             for b in (a + 1)..n {
-                let r = pos[a] - pos[b];
-                // H is even in r and symmetric in the two radii: the same r serves both
+                // H is even in r and symmetric in the two radii: one block serves both
                 // directions of the pair.
-                let ua = self.pair_apply(mu, &r, radii[a], radii[b], &forces[b]);
-                let ub = self.pair_apply(mu, &r, radii[a], radii[b], &forces[a]);
-                out[a] += ua;
-                out[b] += ub;
+                let r = pos[a] - pos[b];
+                let (ci, c) = self.pair_block(mu, &r, radii[a], radii[b]);
+                out[a] += ci * forces[b] + r * (c * r.dot(&forces[b]));
+                out[b] += ci * forces[a] + r * (c * r.dot(&forces[a]));
             }
         }
     }
