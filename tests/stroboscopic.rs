@@ -97,6 +97,40 @@ fn mean_x(s: &Scene) -> f64 {
     (s.displacement(0).unwrap().x + s.displacement(1).unwrap().x) / 2.0
 }
 
+/// A step that ends the run is first tried by Heun's method. On the forced system over 100
+/// periods (no transient), Euler's error against the change is εH/2 over the run of H: a slow
+/// decay (ε = 1e-9: 0.05 tol) lets Heun take the run with one new slope (2 samples at the Euler
+/// stage after the 3 of the first slope); a fast one (ε = 1e-2: 500 tol) is refused, and
+/// Dormand-Prince takes the run. Both end within the tolerance contract (ten times tol of the change, as
+/// `the_error_stays_within_ten_times_the_tolerance`) of the exact solution.
+#[test]
+fn a_closing_step_takes_heun_where_the_motion_is_slow_enough() {
+    let tol = 1e-6;
+    for (eps, heun) in [(1e-9, true), (1e-2, false)] {
+        let mut sys = Forced { eps, a: 0.5 };
+        let mut st = Stroboscopic::new(tol, 1.0, Box::new(Rk4::new(1.0 / 400.0)), 0, 1.0);
+        let mut y = vec![1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+        let (mut t, t_end) = (0.0, 100.0);
+        let mut stats = Stats::default();
+        while t < t_end {
+            t = st.step(&mut sys, t, &mut y, t_end, &mut stats).unwrap();
+        }
+        let exact = sys.exact(1.0, t_end);
+        let change = (exact - 1.0).abs();
+        let err = (y[0] - exact).abs() / change;
+        assert!(err <= 10.0 * tol, "eps {eps}: error {err:e} of the change");
+        if heun {
+            assert_eq!((stats.micro_periods, stats.rejected), (5, 0), "eps {eps}");
+        } else {
+            assert!(
+                stats.micro_periods > 5 && stats.rejected >= 1,
+                "eps {eps}: {stats:?}"
+            );
+        }
+        assert!(stats.macro_steps >= 1, "eps {eps}: {stats:?}");
+    }
+}
+
 #[test]
 fn the_transient_is_the_direct_run() {
     // With RK4 at the direct default step as the inner integrator, the first period (the spring settling from

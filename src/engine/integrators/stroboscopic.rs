@@ -559,8 +559,8 @@ impl Stepper for Stroboscopic {
             // takes it at the price of one slope, where a rejection costs that slope only.
             if m == whole && self.fixed.is_none() && !heun_tried {
                 heun_tried = true;
-                if let Some((y_new, e)) = self.heun_step(sys, t, y, &k1, m, stats) {
-                    if e <= 1.0 {
+                match self.heun_step(sys, t, y, &k1, m, stats) {
+                    Some((y_new, e)) if e <= 1.0 => {
                         y.copy_from_slice(&y_new);
                         // The next step, if any, probes its own slope.
                         self.slope = None;
@@ -569,6 +569,7 @@ impl Stepper for Stroboscopic {
                         self.fallback = None;
                         return Ok(self.leave(snap(t + m as f64 * period), y));
                     }
+                    _ => stats.rejected += 1,
                 }
             }
             let attempt = self.macro_step(sys, t, y, &k1, m, stats);
