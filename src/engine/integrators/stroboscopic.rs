@@ -34,7 +34,8 @@
 //! - **Closing step.** A step that ends the run is first tried by Heun's method with Euler's
 //!   embedded estimate: one new slope instead of six. A slow motion over a short run (a pair over
 //!   100 periods changes its slope by far less than the tolerance) takes it; a rejection costs
-//!   that one slope, and Dormand-Prince takes the step as before.
+//!   that one slope, Dormand-Prince takes the step as before, and Heun is not tried again until
+//!   the next start (a motion too fast for it once is rarely slow enough later in the run).
 //! - **Direct runs.** The start transient (whenever the state is not the one this stepper left:
 //!   a fresh run, a changed phase, a loaded scene), a remainder of less than [`MIN_MACRO`] periods
 //!   and the fraction of a period before `t_end` are integrated by the inner (microscopic)
@@ -160,6 +161,9 @@ pub struct Stroboscopic {
     /// The latest fall-back to direct integration: its time, why, and the periods integrated
     /// directly since the macro steps last succeeded.
     fallback: Option<Fallback>,
+    /// Heun's closing step was refused since the start: the motion is not that slow, and it is
+    /// not tried again.
+    heun_refused: bool,
 }
 
 /// Macro steps that failed at their shortest length, and the direct integration that followed.
@@ -199,6 +203,7 @@ impl Stroboscopic {
             direct_periods: MIN_MACRO,
             interrupt: None,
             fallback: None,
+            heun_refused: false,
         }
     }
 
@@ -510,6 +515,7 @@ impl Stepper for Stroboscopic {
             self.slope = None;
             self.degree = 2;
             self.direct_periods = MIN_MACRO;
+            self.heun_refused = false;
             // First try the whole run in one macro step: a slow motion takes it, and a rejection
             // costs one step's samples.
             self.h_periods = f64::INFINITY;
@@ -549,14 +555,15 @@ impl Stepper for Stroboscopic {
             None => self.probed_slope(sys, t, y, stats)?,
         };
         let mut rejects = 0;
-        let mut heun_tried = false;
+        let mut heun_tried = self.heun_refused;
         loop {
             let m = match self.fixed {
                 Some(m) => m,
                 None => (self.h_periods.min(whole as f64).floor() as u64).clamp(MIN_MACRO, whole),
             };
             // A step that ends the run first tries Heun's method: a slow motion over a short run
-            // takes it at the price of one slope, where a rejection costs that slope only.
+            // takes it at the price of one slope, where a rejection costs that slope only, once
+            // a run.
             if m == whole && self.fixed.is_none() && !heun_tried {
                 heun_tried = true;
                 match self.heun_step(sys, t, y, &k1, m, stats) {
@@ -569,7 +576,10 @@ impl Stepper for Stroboscopic {
                         self.fallback = None;
                         return Ok(self.leave(snap(t + m as f64 * period), y));
                     }
-                    _ => stats.rejected += 1,
+                    _ => {
+                        stats.rejected += 1;
+                        self.heun_refused = true;
+                    }
                 }
             }
             let attempt = self.macro_step(sys, t, y, &k1, m, stats);
