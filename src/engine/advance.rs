@@ -3,7 +3,7 @@
 //! there, with the run's interrupt and a workspace of their own.
 
 use super::error::{invalid, EngineError, Result};
-use super::integrators::{require_resolvable, IntegratorSpec};
+use super::integrators::require_resolvable;
 use super::model::{vec3, Model, STATE_PER_SWIMMER};
 use super::plan::plan;
 use super::scene::{Scene, MAX_TIME_IN_PERIODS};
@@ -55,10 +55,7 @@ pub fn check_steps(s: &Scene, t_end: f64) -> Result<()> {
             periods(latest - s.time()),
         ));
     }
-    if let IntegratorSpec::Euler { dt }
-    | IntegratorSpec::Rk4 { dt }
-    | IntegratorSpec::Platen { dt } = s.integrator()
-    {
+    if let Some(dt) = s.integrator().fixed_step() {
         let scale = s.time().abs().max(t_end.abs());
         require_resolvable(
             &format!("the step dt = {dt:e} s"),

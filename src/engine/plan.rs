@@ -1,9 +1,8 @@
 //! Where the next run goes: the CPU, or the GPU when the backend, the model, the options and the
 //! integrator allow it (and, for "auto", when the scene is above the measured crossover).
 
-use super::backend::{self, Backend};
+use super::backend::Backend;
 use super::calibrate;
-use super::contacts::Contacts;
 use super::error::{unsupported, Result, Setting};
 use super::model::Model;
 use super::scene::Scene;
@@ -29,26 +28,9 @@ pub fn backend_info(s: &Scene) -> Result<String> {
     plan(s).map(|p| p.to_string())
 }
 
-/// The options the device kernels do not have: a periodic box, contact handling, the cutoff,
-/// thermal noise.
-fn gpu_options_supported(s: &Scene) -> std::result::Result<(), String> {
-    let cpu_only = |what: &str| Err(format!("{what} runs on the CPU only"));
-    match s.model() {
-        _ if s.periodic().is_some() => cpu_only("a periodic box (Ewald sums, minimum images)"),
-        _ if s.thermal().is_on() => cpu_only("thermal noise (temperature above 0)"),
-        _ if s.contacts() != Contacts::default() => {
-            cpu_only("contact handling (overlaps allowed, steric repulsion)")
-        }
-        Model::Averaged if s.cutoff().is_some() => cpu_only("the far-field cutoff"),
-        _ => Ok(()),
-    }
-}
-
 /// Whether the next run of `s` takes the GPU, and why.
 pub fn plan(s: &Scene) -> Result<Plan> {
-    let fit = backend::gpu_model_supported(s.model())
-        .and_then(|()| gpu_options_supported(s))
-        .and_then(|()| backend::gpu_tableau(&s.integrator()).map(|_| ()));
+    let fit = super::gpu::support::supports(s);
     let cpu = |why: String| Ok(Plan { gpu: false, why });
     match s.backend() {
         Backend::Cpu => cpu("the cpu backend was chosen".into()),

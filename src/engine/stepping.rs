@@ -5,9 +5,8 @@
 //! Which backend a run takes is decided above this module ([`super::plan`], [`super::advance`]):
 //! the calibration of "auto" steps both backends through here.
 
-use super::backend;
-use super::backend::GpuSteps;
 use super::error::{invalid, unsupported, EngineError, Result, Setting};
+use super::gpu::support::{self, GpuSteps};
 use super::gpu::{AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
 use super::integrators::{uniform_steps, IntegratorSpec, Stepper};
 use super::model::Model;
@@ -228,7 +227,7 @@ pub fn advance_gpu(
     control: &RunControl,
     t_end: f64,
 ) -> Result<()> {
-    let (steps, tableau) = backend::gpu_tableau(&s.integrator()).map_err(|e| invalid!("{e}"))?;
+    let (steps, tableau) = support::tableau(&s.integrator()).map_err(|e| invalid!("{e}"))?;
     let model = match s.model() {
         Model::Micro => GpuModel::Micro {
             mu: s.mu(),

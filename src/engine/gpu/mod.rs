@@ -21,6 +21,7 @@ pub mod device;
 pub mod micro_rates;
 pub mod rk_stages;
 pub mod runner;
+pub mod support;
 
 pub use device::{available, device, quiet_device_selection, GpuDevice};
 pub use runner::{AdaptiveReport, AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};

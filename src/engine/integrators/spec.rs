@@ -132,6 +132,13 @@ pub struct Method {
     pub about: &'static str,
     /// The checked constructor.
     pub make: fn(f64) -> Result<IntegratorSpec>,
+    /// Steps of exactly the parameter (s) rather than error control: the checks before a run
+    /// (the step resolvable at the scene's time, the step count bounded) apply.
+    pub fixed_step: bool,
+    /// A scheme for thermal noise (the deterministic methods refuse a temperature).
+    pub takes_noise: bool,
+    /// The GPU backend steps it (`gpu::support::tableau` holds its device tableau).
+    pub gpu: bool,
 }
 
 const EULER: Method = Method {
@@ -140,6 +147,9 @@ const EULER: Method = Method {
     parameter_about: "the step in s",
     about: "forward Euler, fixed step",
     make: IntegratorSpec::euler,
+    fixed_step: true,
+    takes_noise: true,
+    gpu: true,
 };
 
 const RK4: Method = Method {
@@ -148,6 +158,9 @@ const RK4: Method = Method {
     parameter_about: "the step in s",
     about: "classic Runge-Kutta, fixed step",
     make: IntegratorSpec::rk4,
+    fixed_step: true,
+    takes_noise: false,
+    gpu: true,
 };
 
 const DOPRI5: Method = Method {
@@ -156,6 +169,9 @@ const DOPRI5: Method = Method {
     parameter_about: "the relative tolerance",
     about: "adaptive Dormand-Prince 5(4)",
     make: IntegratorSpec::dopri5,
+    fixed_step: false,
+    takes_noise: false,
+    gpu: true,
 };
 
 const STROBOSCOPIC: Method = Method {
@@ -164,6 +180,9 @@ const STROBOSCOPIC: Method = Method {
     parameter_about: "the tolerance relative to the drift",
     about: "stroboscopic averaging: macro steps of many periods (spring and rigid models)",
     make: IntegratorSpec::stroboscopic,
+    fixed_step: false,
+    takes_noise: false,
+    gpu: false,
 };
 
 const AUTO: Method = Method {
@@ -172,6 +191,9 @@ const AUTO: Method = Method {
     parameter_about: "the tolerance relative to the drift",
     about: "the cheapest method expected to meet tol for the scene (s.integrator_info says which)",
     make: IntegratorSpec::auto,
+    fixed_step: false,
+    takes_noise: false,
+    gpu: false,
 };
 
 const SUSPENSION: Method = Method {
@@ -180,6 +202,9 @@ const SUSPENSION: Method = Method {
     parameter_about: "the tolerance relative to each swimmer's displacement over a step",
     about: "for suspensions (averaged model): implicit in the steric contacts, each swimmer's error against its own displacement",
     make: IntegratorSpec::suspension,
+    fixed_step: false,
+    takes_noise: false,
+    gpu: false,
 };
 
 const PLATEN: Method = Method {
@@ -188,6 +213,9 @@ const PLATEN: Method = Method {
     parameter_about: "the step in s",
     about: "Platen's weak order 2 scheme for thermal noise, fixed step (Heun without noise)",
     make: IntegratorSpec::platen,
+    fixed_step: true,
+    takes_noise: true,
+    gpu: false,
 };
 
 const ROSW: Method = Method {
@@ -196,6 +224,9 @@ const ROSW: Method = Method {
     parameter_about: "the relative tolerance",
     about: "adaptive Rosenbrock-W ROS34PW2, for stiff springs",
     make: IntegratorSpec::rosw,
+    fixed_step: false,
+    takes_noise: false,
+    gpu: false,
 };
 
 /// Every method, in the order messages list them.
@@ -258,10 +289,26 @@ impl IntegratorSpec {
 
     /// Whether the method is a scheme for thermal noise (Euler-Maruyama or Platen's).
     pub fn takes_noise(&self) -> bool {
-        matches!(
-            self,
-            IntegratorSpec::Euler { .. } | IntegratorSpec::Platen { .. }
-        )
+        self.method().takes_noise
+    }
+
+    /// The step (s) of a fixed-step method; `None` for error-controlled ones.
+    pub fn fixed_step(&self) -> Option<f64> {
+        self.method().fixed_step.then(|| self.parameter())
+    }
+
+    /// The same method through its checked constructor (and its inner method's): a value read
+    /// from a file is refused as the script's constructor would refuse it.
+    pub fn checked(&self) -> Result<Self> {
+        match *self {
+            IntegratorSpec::Stroboscopic { tol, inner } => {
+                let inner = inner
+                    .map(|i| IntegratorSpec::from(i).checked())
+                    .transpose()?;
+                Self::stroboscopic_with(tol, inner)
+            }
+            _ => (self.method().make)(self.parameter()),
+        }
     }
 
     /// Dormand-Prince 5(4), checked: 1e-14 ≤ rtol < 1.

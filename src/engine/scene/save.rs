@@ -4,7 +4,6 @@
 
 use super::super::contacts::Steric;
 use super::super::error::{invalid, require_finite, require_positive, Result};
-use super::super::integrators::IntegratorSpec;
 use super::super::model::{vec3, Model, STATE_PER_SWIMMER};
 use super::super::swimmer::Dumbbell;
 use super::Scene;
@@ -77,24 +76,8 @@ impl Scene {
     /// by hand, truncated or written by something else is refused with the value at fault.
     pub(super) fn validate(&self) -> Result<()> {
         require_positive("mu", self.mu, "Pa s")?;
-        match self.integrator {
-            Some(IntegratorSpec::Euler { dt }) => IntegratorSpec::euler(dt).map(|_| ())?,
-            Some(IntegratorSpec::Rk4 { dt }) => IntegratorSpec::rk4(dt).map(|_| ())?,
-            Some(IntegratorSpec::Platen { dt }) => IntegratorSpec::platen(dt).map(|_| ())?,
-            Some(IntegratorSpec::Dopri5 { rtol }) => IntegratorSpec::dopri5(rtol).map(|_| ())?,
-            Some(IntegratorSpec::Rosw { rtol }) => IntegratorSpec::rosw(rtol).map(|_| ())?,
-            Some(IntegratorSpec::Stroboscopic { tol, inner }) => {
-                let inner = inner.map(IntegratorSpec::from);
-                if let Some(i) = inner {
-                    (i.method().make)(i.parameter())?;
-                }
-                IntegratorSpec::stroboscopic_with(tol, inner).map(|_| ())?
-            }
-            Some(IntegratorSpec::Auto { tol }) => IntegratorSpec::auto(tol).map(|_| ())?,
-            Some(IntegratorSpec::Suspension { tol }) => {
-                IntegratorSpec::suspension(tol).map(|_| ())?
-            }
-            None => {}
+        if let Some(spec) = self.integrator {
+            spec.checked()?;
         }
         if let Some(st) = self.contacts.steric {
             Steric::new(st.range, st.stiffness)?;
