@@ -1,7 +1,8 @@
 //! src/README.md's table is the map a newcomer reads first: every engine module has a row, and
 //! its "may import" column lists every other engine module the file (with its child modules)
 //! uses. `error` is open to all. Arrows that drift from the code fail here, and so does an import
-//! circle between engine modules (each module must be readable with only those below it).
+//! circle between engine modules or between script modules (each module must be readable with
+//! only those below it); the REPL reaches the engine through the script layer only.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -10,7 +11,12 @@ const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// Top-level engine modules: `engine/x.rs` and `engine/x/` (a folder with mod.rs).
 fn engine_modules() -> BTreeSet<String> {
-    std::fs::read_dir(Path::new(ROOT).join("src/engine"))
+    layer_modules("engine")
+}
+
+/// Top-level modules of the layer in `src/<layer>`: `x.rs` and `x/` (a folder with mod.rs).
+fn layer_modules(layer: &str) -> BTreeSet<String> {
+    std::fs::read_dir(Path::new(ROOT).join("src").join(layer))
         .unwrap()
         .flatten()
         .filter_map(|e| {
@@ -26,19 +32,17 @@ fn engine_modules() -> BTreeSet<String> {
         .collect()
 }
 
-/// The engine modules named in `path` (outside comments) through `crate::engine::x` or a
-/// `super::` chain that climbs to the engine.
-fn imports(path: &Path, depth: usize, modules: &BTreeSet<String>) -> BTreeSet<String> {
+/// The modules of `layer` named in `path` (outside comments) through `crate::<layer>::x` or a
+/// `super::` chain that climbs to the layer.
+fn imports(path: &Path, depth: usize, modules: &BTreeSet<String>, layer: &str) -> BTreeSet<String> {
     let text = std::fs::read_to_string(path).unwrap();
+    let prefix = format!("crate::{layer}::");
     let mut out = BTreeSet::new();
     for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
         let mut rest = line;
-        while let Some(k) = rest
-            .find("super::")
-            .or_else(|| rest.find("crate::engine::"))
-        {
+        while let Some(k) = rest.find("super::").or_else(|| rest.find(&prefix)) {
             let tail = &rest[k..];
-            let (ups, after) = if let Some(a) = tail.strip_prefix("crate::engine::") {
+            let (ups, after) = if let Some(a) = tail.strip_prefix(prefix.as_str()) {
                 (depth, a)
             } else {
                 let mut t = tail;
@@ -81,21 +85,30 @@ fn rs_files(dir: &Path, out: &mut Vec<(std::path::PathBuf, usize)>, depth: usize
 
 /// What each top-level engine module (with its children) imports of the others, `error` aside.
 fn import_graph() -> BTreeMap<String, BTreeSet<String>> {
-    let modules = engine_modules();
+    let mut graph = layer_graph("engine");
+    for used in graph.values_mut() {
+        used.remove("error");
+    }
+    graph
+}
+
+/// What each top-level module of `layer` (with its children) imports of the others.
+fn layer_graph(layer: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let modules = layer_modules(layer);
+    let dir = Path::new(ROOT).join("src").join(layer);
     let mut files = Vec::new();
-    rs_files(&Path::new(ROOT).join("src/engine"), &mut files, 0);
+    rs_files(&dir, &mut files, 0);
     let mut graph = BTreeMap::new();
     for m in &modules {
         let mut used = BTreeSet::new();
         for (p, depth) in &files {
-            let rel = p.strip_prefix(Path::new(ROOT).join("src/engine")).unwrap();
+            let rel = p.strip_prefix(&dir).unwrap();
             let first = rel.iter().next().unwrap().to_string_lossy();
             if first.trim_end_matches(".rs") == m {
-                used.extend(imports(p, *depth, &modules));
+                used.extend(imports(p, *depth, &modules, layer));
             }
         }
         used.remove(m);
-        used.remove("error");
         graph.insert(m.clone(), used);
     }
     graph
@@ -149,9 +162,8 @@ fn the_may_import_column_of_src_readme_is_the_truth() {
     );
 }
 
-#[test]
-fn the_engine_has_no_import_circle() {
-    let graph = import_graph();
+/// The first import circle of `graph`, as the path that closes it.
+fn first_circle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<String> {
     // Depth-first search; a module met again while it is still on the path closes a circle.
     fn visit<'a>(
         m: &'a str,
@@ -177,9 +189,44 @@ fn the_engine_has_no_import_circle() {
         None
     }
     let mut done = BTreeSet::new();
-    for m in graph.keys() {
-        if let Some(circle) = visit(m, &graph, &mut Vec::new(), &mut done) {
-            panic!("engine import circle: {}", circle.join(" → "));
-        }
+    graph
+        .keys()
+        .find_map(|m| visit(m, graph, &mut Vec::new(), &mut done))
+        .map(|c| c.join(" → "))
+}
+
+#[test]
+fn the_engine_has_no_import_circle() {
+    if let Some(c) = first_circle(&import_graph()) {
+        panic!("engine import circle: {c}");
     }
+}
+
+#[test]
+fn the_script_layer_has_no_import_circle() {
+    if let Some(c) = first_circle(&layer_graph("script")) {
+        panic!("script import circle: {c}");
+    }
+}
+
+/// The REPL and the kernel speak to the script layer; the engine's names reach them through it.
+#[test]
+fn the_repl_reaches_the_engine_through_the_script_layer() {
+    let mut files = Vec::new();
+    rs_files(&Path::new(ROOT).join("src/repl"), &mut files, 0);
+    let reaching: Vec<String> = files
+        .iter()
+        .filter(|(p, _)| {
+            std::fs::read_to_string(p)
+                .unwrap()
+                .lines()
+                .filter(|l| !l.trim_start().starts_with("//"))
+                .any(|l| l.contains("crate::engine"))
+        })
+        .map(|(p, _)| p.display().to_string())
+        .collect();
+    assert!(
+        reaching.is_empty(),
+        "the REPL imports the engine directly in {reaching:?}"
+    );
 }

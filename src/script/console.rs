@@ -77,11 +77,11 @@ pub fn note(text: &str) {
     }
 }
 
-/// Show `v` now: through the display sink, else as the shell shows values.
-pub fn display(v: &rhai::Dynamic) {
+/// Show `v` now: through the display sink, else as `text` gives it (the shell's text of values).
+pub fn display(v: &rhai::Dynamic, text: impl FnOnce(&rhai::Dynamic) -> String) {
     match DISPLAY.get() {
         Some(f) => f(v),
-        None => write(&format!("{}\n", super::show(v))),
+        None => write(&format!("{}\n", text(v))),
     }
 }
 

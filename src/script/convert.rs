@@ -1,10 +1,28 @@
 //! Conversions between Rhai values and engine values, with errors that say what was expected.
 
-pub use super::types::describe;
 use crate::engine::error::Setting;
 use crate::engine::EngineError;
 use nalgebra::Vector3;
 use rhai::{Array, Dynamic, EvalAltResult, Position, FLOAT, INT};
+use std::sync::OnceLock;
+
+/// How messages quote a value ("euler(1e-6) (Integrator)"): the shell's `describe`, which knows
+/// every script type and so sits above the binding files that quote values; installed by the
+/// engine builder.
+static DESCRIBE: OnceLock<fn(&Dynamic) -> String> = OnceLock::new();
+
+/// Install how messages quote a value (the engine builder does, before any script runs).
+pub fn install_describe(f: fn(&Dynamic) -> String) {
+    let _ = DESCRIBE.set(f);
+}
+
+/// A value as a message quotes it: its text and its type, "euler(1e-6) (Integrator)"; Rhai's
+/// type name before an engine was built.
+pub fn describe(v: &Dynamic) -> String {
+    DESCRIBE
+        .get()
+        .map_or_else(|| v.type_name().to_string(), |f| f(v))
+}
 
 /// Result type of script-visible functions.
 pub type ScriptResult<T> = Result<T, Box<EvalAltResult>>;

@@ -1,7 +1,7 @@
 //! `write_csv(path, rows)` / `write_csv(path, columns, rows)`: tables from scripts.
 
 use super::convert::{describe, script_error, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use crate::engine::files::{check_csv_name, write_atomically};
 use rhai::{Array, Dynamic, Engine, Map};
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! `dumbbell(#{...})`: a swimmer's parameters and pose, before it is added to a scene.
 
 use super::convert::{array3, number, script_error, unknown_choice, vector3, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use crate::engine::swimmer::unit_direction;
 use crate::engine::Dumbbell;
 use nalgebra::Vector3;

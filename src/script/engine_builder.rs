@@ -2,8 +2,8 @@
 
 use super::{
     csv_api, dumbbell_api, field_api, float_cmp, integrator_api, interrupt, limits, observable_api,
-    panic_guard::guard, params, picture_api, plot_api, render_error, scene_api, stdlib, sweep_api,
-    types, util_api, wrong_calls,
+    panic_guard::guard, params, picture_api, plot_api, render_error, scene_api, scene_settings_api,
+    stdlib, sweep_api, types, util_api, wrong_calls,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -32,9 +32,11 @@ pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModu
     engine.set_max_expr_depths(256, 256);
     limits::apply(&mut engine);
     types::register(&mut engine);
+    super::convert::install_describe(super::show::describe);
     dumbbell_api::register(&mut engine);
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);
+    scene_settings_api::register(&mut engine);
     observable_api::register(&mut engine);
     float_cmp::register(&mut engine);
     csv_api::register(&mut engine);

@@ -3,7 +3,7 @@
 //! the recorder observable `field_stat(kind, stat[, opts])`.
 
 use super::convert::{describe, lift, number, script_error, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use super::picture_api::Picture;
 use super::scene_api::SceneHandle;
 use crate::engine::fields::{structure_factor, Field, FieldKind, FieldSpec, FieldStat};

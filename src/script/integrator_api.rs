@@ -3,7 +3,7 @@
 //! inner)` with an inner method.
 
 use super::convert::{lift, number, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use crate::engine::integrators::METHODS;
 use crate::engine::IntegratorSpec;
 use rhai::{Dynamic, Engine};

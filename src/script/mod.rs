@@ -4,6 +4,7 @@
 pub mod console;
 mod convert;
 mod csv_api;
+mod doc;
 pub mod docs;
 mod dumbbell_api;
 mod engine_builder;
@@ -37,6 +38,7 @@ pub fn suggest_name(word: &str) -> Option<&'static str> {
     let names: Vec<&'static str> = docs::DOCS.iter().map(|d| d.name).collect();
     convert::suggest(word, &names)
 }
+pub use crate::engine::files::write_atomically;
 pub use crate::engine::gpu::quiet_device_selection;
 pub use dumbbell_api::DumbbellSpec;
 pub use engine_builder::{

@@ -6,7 +6,7 @@
 //! silently), and so is a `let NAME = ...` or `const NAME = ...` that would shadow the value
 //! without reading it (write `let NAME = param("NAME", default);` instead).
 
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use rhai::{Dynamic, Engine, Position, AST};
 
 /// The `--set` values of one run, in command-line order.

@@ -3,8 +3,8 @@
 //! it is; `pic.save(path)` writes it.
 
 use super::convert::{script_error, ScriptResult};
-use super::docs::doc_entry;
-use super::docs::Doc;
+use super::doc::doc_entry;
+use super::doc::Doc;
 use crate::plot::Image;
 use rhai::Engine;
 use std::sync::Arc;
@@ -55,19 +55,11 @@ impl std::fmt::Display for Picture {
 
 /// Register the `Picture` type.
 pub fn register(engine: &mut Engine) {
-    engine
-        .register_fn("save", |p: &mut Picture, path: &str| p.save(path))
-        .register_fn("display", |v: rhai::Dynamic| super::console::display(&v));
+    engine.register_fn("save", |p: &mut Picture, path: &str| p.save(path));
 }
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[doc_entry!(
-    "display",
-    "pictures",
-    "display(value)",
-    "Show a value now, in the middle of a cell or a loop: a notebook shows a Picture inline and other values as text; at the prompt or in a script it prints the value as the shell shows it.",
-    "let s = scene(); s.add(dumbbell()); for k in 0..2 { s.run_periods(1.0); display(s.time); }"
-), doc_entry!(
     "Picture",
     "pictures",
     "plot(series) -> Picture\nplot(series, options) -> Picture\nrec.plot(x_column, y_columns) -> Picture\ns.snapshot() -> Picture\ns.snapshot(options) -> Picture\npic.save(path)",

@@ -6,7 +6,7 @@
 //! map `#{ title, x_label, y_label, log_x, log_y, width, height }` (and `cols`, `rows` for text).
 
 use super::convert::{describe, lift, number, script_error, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
 use super::picture_api::Picture;
 use super::scene_api::SceneHandle;

@@ -6,7 +6,7 @@
 //! ([`interrupt`]).
 
 use super::convert::{array3, describe, index, lift, number, script_error, ScriptResult};
-use super::docs::{self, doc_entry, Doc};
+use super::doc::{self, doc_entry, Doc};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
 use crate::engine::{Backend, Scene, Simulation};
@@ -365,8 +365,6 @@ pub fn register(engine: &mut Engine) {
         },
     );
 
-    super::scene_settings_api::register(engine);
-
     // Reading one swimmer.
     engine
         .register_fn(
@@ -567,7 +565,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("add", "building", "s.add(d: Dumbbell) -> int", "Add a swimmer at length L(t) of the scene's time, its hydrodynamic centre at d.center, pointing along d.dir; returns its 0-based index. Refuses overlapping swimmers.", "let s = scene(); let i = s.add(dumbbell()); print(i);"),
     doc_entry!("copy", "building", "s.copy() -> Scene", "An independent copy of the scene (same state, no recorders). `let t = s;` would name the same scene.", "let s = scene(); let t = s.copy(); t.add(dumbbell()); print(s.count);"),
     doc_entry!("phase", "phases", "phase(x) -> float\ns.phase(i) -> float", "phase(x): x radians wrapped to [0, 2 pi). s.phase(i): the stroke phase of swimmer i.", "print(phase(7.0)); let s = scene(); s.add(dumbbell(#{ phase: 1.0 })); print(s.phase(0));"),
-    doc_entry!("phases", "phases", "s.phases -> array\ns.phases = [..]", "All stroke phases (rad) in swimmer order; assign one per swimmer.", docs::PAIR_PHASES),
+    doc_entry!("phases", "phases", "s.phases -> array\ns.phases = [..]", "All stroke phases (rad) in swimmer order; assign one per swimmer.", doc::PAIR_PHASES),
     doc_entry!("set_phase", "phases", "s.set_phase(i, phi)", "Set the stroke phase of swimmer i (rad).", "let s = scene(); s.add(dumbbell()); s.set_phase(0, pi()); print(s.phases);"),
     doc_entry!("add_random", "scene", "s.add_random(d, n, volume_fraction, seed) -> int\ns.add_random(d, n, volume_fraction, seed, #{ aligned: [x, y, z], phase: p }) -> int\ns.add_random(d, n, seed[, opts]) -> int  (in a periodic box)", "Add n copies of dumbbell d at random places in a cube centred on the origin, sized so that all spheres fill the given volume fraction (in a periodic box: the box itself, measured by minimum images), without overlaps (random sequential addition, seeded: the same seed gives the same scene). Orientations and phases are random unless fixed by the options; gap: m sets the smallest sphere gap at placement (default 4 lambda max(w1, w2), what the strokes can close). Returns the new swimmer count; on failure the scene is unchanged.", "let s = scene(); s.add_random(dumbbell(#{}), 20, 0.01, 1); print(s.count);"),
     doc_entry!("add_at", "scene", "s.add_at(d, centres: array) -> int", "Add a copy of dumbbell d (its orientation and phase) at every centre [x, y, z] (m) of the array, e.g. a lattice from the stdlib module \"lattice\". All or nothing: if one does not fit, the scene is unchanged. Returns the new swimmer count.", "import \"lattice\" as lattice; let s = scene(); s.add_at(dumbbell(), lattice::cubic(2, 2, 2, 20e-6)); print(s.count);"),
@@ -578,7 +576,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("sphere_velocities", "reading", "s.sphere_velocities(forces) -> [[vx, vy, vz], ...]", "Sphere velocities (m/s) for given forces (N): one [fx, fy, fz] per sphere, swimmer by swimmer, the a1 sphere first; the scene's mobility and viscosity at the present sphere positions, Stokes drag included. For checks against other codes; the scene does not move.", "let s = scene(); s.add(dumbbell()); print(s.sphere_velocities([[1e-12, 0, 0], [0, 0, 0]]));"),
     doc_entry!("center", "reading", "s.center(i) -> [x, y, z]", "Hydrodynamic centre R_H of swimmer i (m).", "let s = scene(); s.add(dumbbell()); print(s.center(0));"),
     doc_entry!("dir", "reading", "s.dir(i) -> [x, y, z]", "Unit orientation N of swimmer i (from the a1 sphere to the a2 sphere).", "let s = scene(); s.add(dumbbell(#{ dir: [0, 1, 0] })); print(s.dir(0));"),
-    doc_entry!("velocity", "reading", "s.velocity(i) -> [x, y, z]", "dR_H/dt of swimmer i now (m/s).", docs::PAIR_VELOCITY),
+    doc_entry!("velocity", "reading", "s.velocity(i) -> [x, y, z]", "dR_H/dt of swimmer i now (m/s).", doc::PAIR_VELOCITY),
     doc_entry!("spin", "reading", "s.spin(i) -> [x, y, z]", "dN/dt of swimmer i now (1/s).", "let s = scene(); s.add(dumbbell()); print(s.spin(0));"),
     doc_entry!("length", "reading", "s.length(i) -> float\nlength(i) -> Observable", "Length |X2 - X1| of swimmer i (m); as a global function, the observable.", "let s = scene(); s.add(dumbbell()); print(s.length(0)); print(length(0));"),
     doc_entry!("swimmer", "reading", "s.swimmer(i) -> Dumbbell", "Parameters and current pose of swimmer i.", "let s = scene(); s.add(dumbbell()); print(s.swimmer(0));"),

@@ -4,7 +4,7 @@
 //! `backend_info`.
 
 use super::convert::{describe, lift, number, script_error, unknown_choice, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use super::scene_api::SceneHandle;
 use crate::engine::choice::{self, Named};
 use crate::engine::ewald::EwaldMethod;

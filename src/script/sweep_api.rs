@@ -10,7 +10,7 @@
 //! change is an error naming the fix (build the scene in the call, or change a copy).
 
 use super::convert::{script_error, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
 use super::scene_api::SceneHandle;
 use rayon::prelude::*;
@@ -81,7 +81,7 @@ fn sweep(
             r.map_err(|(k, e)| {
                 script_error(format!(
                     "sweep: the call for parameter {k} ({}) failed: {}",
-                    super::types::quote(&params[k]),
+                    super::show::quote(&params[k]),
                     super::render::message_of(&e)
                 ))
             })

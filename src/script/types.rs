@@ -1,7 +1,7 @@
 //! swimlab's script types, each named once in the words scripts use: their registration (name,
 //! `to_string` and `to_debug` through their `Display`), their text (what `print`, `display` and
-//! the shell show), and the type word every message gives for a value ("got euler(1e-6)
-//! (Integrator)"). Rhai's own messages name custom types by their Rust paths; [`in_words`]
+//! the shell show), and the type word every message gives for a value (the "Integrator" of "got
+//! euler(1e-6) (Integrator)"). Rhai's own messages name custom types by their Rust paths; [`in_words`]
 //! rewrites those, so no Rust path reaches a user.
 
 use super::dumbbell_api::DumbbellSpec;
@@ -11,9 +11,6 @@ use super::scene_api::SceneHandle;
 use crate::engine::fields::Field;
 use crate::engine::{IntegratorSpec, Observable, Trigger};
 use rhai::{Dynamic, Engine};
-
-/// Longest value text a message quotes (a scene's summary runs to a few hundred characters).
-const QUOTED_CHARS: usize = 80;
 
 macro_rules! script_types {
     ($($t:ty => $name:literal),+ $(,)?) => {
@@ -117,26 +114,6 @@ pub fn type_word(v: &Dynamic) -> String {
     script_name(rust).map_or_else(|| in_words(rust), str::to_string)
 }
 
-/// A value as a message quotes it: its text (as the shell shows it, shortened) and its type,
-/// "euler(1e-6) (Integrator)", "\"x\" (string)"; `()` alone.
-pub fn describe(v: &Dynamic) -> String {
-    if v.is_unit() {
-        return "()".into();
-    }
-    format!("{} ({})", quote(v), type_word(v))
-}
-
-/// A value as a message quotes it: its text as the shell shows it, shortened.
-pub fn quote(v: &Dynamic) -> String {
-    let text = super::show(v);
-    if text.chars().count() > QUOTED_CHARS {
-        let cut: String = text.chars().take(QUOTED_CHARS).collect();
-        format!("{cut}…")
-    } else {
-        text
-    }
-}
-
 /// `msg` with every Rust type path of a script type (and Rhai's string type spellings) in
 /// script words; any other `swimlab::` path is cut to its last segment.
 pub fn in_words(msg: &str) -> String {
@@ -173,21 +150,6 @@ mod tests {
             assert!(!name.contains("::"), "{name}");
             assert_eq!(script_name(rust), Some(*name));
         }
-    }
-
-    #[test]
-    fn values_are_described_in_script_words() {
-        let spec = Dynamic::from(IntegratorSpec::Euler { dt: 1e-6 });
-        assert_eq!(type_word(&spec), "Integrator");
-        let d = describe(&spec);
-        assert!(
-            d.starts_with("euler(") && d.ends_with("(Integrator)"),
-            "{d}"
-        );
-        assert_eq!(type_word(&Dynamic::from_int(1)), "int");
-        assert_eq!(type_word(&Dynamic::from_float(1.0)), "float");
-        assert_eq!(type_word(&Dynamic::from("x")), "string");
-        assert_eq!(describe(&Dynamic::UNIT), "()");
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Small helpers scripts need: number formatting, `pi()`, and the quick mode of long scripts.
 
 use super::convert::{number, ScriptResult};
-use super::docs::{doc_entry, Doc};
+use super::doc::{doc_entry, Doc};
 use super::limits;
 use rhai::{Dynamic, Engine, INT};
 
@@ -67,11 +67,21 @@ pub fn register(engine: &mut Engine) {
         })
         .register_fn("lpad", |x: Dynamic, width: INT| pad(&x, width, false))
         .register_fn("rpad", |x: Dynamic, width: INT| pad(&x, width, true))
-        .register_fn("is_number", |x: Dynamic| x.is_float() || x.is_int());
+        .register_fn("is_number", |x: Dynamic| x.is_float() || x.is_int())
+        .register_fn("display", |v: Dynamic| {
+            super::console::display(&v, super::show)
+        });
 }
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[
+    doc_entry!(
+        "display",
+        "pictures",
+        "display(value)",
+        "Show a value now, in the middle of a cell or a loop: a notebook shows a Picture inline and other values as text; at the prompt or in a script it prints the value as the shell shows it.",
+        "let s = scene(); s.add(dumbbell()); for k in 0..2 { s.run_periods(1.0); display(s.time); }"
+    ),
     doc_entry!(
         "sci",
         "formatting",

@@ -51,7 +51,7 @@ pub fn install(target: &Target) -> Result<PathBuf, String> {
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot make {}: {e}", dir.display()))?;
     let text = serde_json::to_string_pretty(&kernel_json(&exe)).unwrap_or_default();
     let path = dir.join("kernel.json");
-    crate::engine::files::write_atomically(&path, |w| w.write_all(text.as_bytes()))
+    crate::script::write_atomically(&path, |w| w.write_all(text.as_bytes()))
         .map_err(|e| e.to_string())?;
     Ok(dir)
 }
