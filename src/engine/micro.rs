@@ -62,11 +62,11 @@ impl MicroSystem {
         }
     }
 
-    /// Put the swimmers in the periodic box of `ewald` (its sums give the mobility). The stiff
-    /// own-pair rates behind rosw's Jacobian stay open space's: a W-method needs only an
-    /// approximate Jacobian, and a box longer than the swimmer changes the own pair little.
-    pub fn set_periodic(&mut self, ewald: Option<crate::engine::ewald::Ewald>) {
-        self.spheres.set_periodic(ewald);
+    /// Take `operator` as the boundary's mobility (open space until set). The stiff own-pair
+    /// rates behind rosw's Jacobian stay open space's: a W-method needs only an approximate
+    /// Jacobian, and a box longer than the swimmer changes the own pair little.
+    pub fn set_mobility(&mut self, operator: Box<dyn crate::engine::mobility::MobilityOperator>) {
+        self.spheres.set_mobility(operator);
     }
 
     /// Thermal noise at `thermal`'s temperature (none at 0 K).

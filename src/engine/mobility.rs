@@ -7,6 +7,7 @@
 //! (the hydrodynamic centre is the centre of friction), instead of cancelling them in floating point.
 
 use super::choice::{self, Choice, Named};
+use super::periodic::PeriodicBox;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -151,4 +152,52 @@ impl Mobility {
 #[inline]
 pub fn self_mobility(mu: f64, a: f64) -> f64 {
     1.0 / (6.0 * PI * mu * a)
+}
+
+/// The mobility of a set of spheres in one boundary (open space, a periodic box): how the forces
+/// on the spheres become their velocities. Built once where the scene's settings change and
+/// owned by the sphere models; each boundary is one implementation.
+///
+/// Every boundary splits its mobility as M = D + W: D the free Stokes drag 1/(6πμa) of each
+/// sphere, which the models apply themselves (it cancels from dR_H/dt exactly), and W all the
+/// rest (the pairs, and whatever the boundary adds to a sphere's own flow, as a box's images
+/// do), which [`MobilityOperator::interaction_velocities`] applies.
+pub trait MobilityOperator: std::fmt::Debug + Send + Sync {
+    /// u_α = (W F)_α at positions `pos` of spheres of radii `radii`: every velocity the forces
+    /// give beyond each sphere's own Stokes drag.
+    fn interaction_velocities(
+        &mut self,
+        pos: &[Vector3<f64>],
+        radii: &[f64],
+        forces: &[Vector3<f64>],
+        out: &mut [Vector3<f64>],
+    );
+
+    /// The 3×3 block M_αβ between spheres at `xa` and `xb` of radii `ai`, `aj`; `same`: α = β,
+    /// the self block, Stokes drag included.
+    fn block(
+        &self,
+        xa: &Vector3<f64>,
+        xb: &Vector3<f64>,
+        ai: f64,
+        aj: f64,
+        same: bool,
+    ) -> Matrix3<f64>;
+
+    /// The full 3N×3N matrix M, self blocks included (dense noise roots, tests).
+    fn matrix(&self, pos: &[Vector3<f64>], radii: &[f64]) -> DMatrix<f64>;
+
+    /// The periodic box, when the boundary is one (minimum images, gaps).
+    fn periodic(&self) -> Option<&PeriodicBox> {
+        None
+    }
+
+    /// A copy behind a box (the models are cloned with their scenes).
+    fn boxed(&self) -> Box<dyn MobilityOperator>;
+}
+
+impl Clone for Box<dyn MobilityOperator> {
+    fn clone(&self) -> Self {
+        self.boxed()
+    }
 }

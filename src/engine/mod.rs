@@ -25,6 +25,7 @@ pub mod mobility;
 pub mod model;
 pub mod neighbours;
 pub mod observable;
+pub mod open_space;
 pub mod pairs;
 pub mod periodic;
 pub mod plan;

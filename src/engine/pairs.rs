@@ -29,6 +29,7 @@
 use super::mobility::Mobility;
 use super::periodic::PeriodicBox;
 use super::simd::{lane_sum, vector_dispatch, InvSqrt};
+use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -82,6 +83,23 @@ impl SoaSpheres {
     pub fn set_radius(&mut self, i: usize, a: f64) {
         self.a[i] = a;
         self.a2[i] = a * a;
+    }
+
+    /// Fill with spheres at `pos` of radii `radii`, and their `forces` when given (the gap
+    /// passes need none).
+    pub fn fill(&mut self, pos: &[Vector3<f64>], radii: &[f64], forces: Option<&[Vector3<f64>]>) {
+        self.resize(pos.len());
+        for (i, (p, a)) in pos.iter().zip(radii).enumerate() {
+            self.x[i] = p.x;
+            self.y[i] = p.y;
+            self.z[i] = p.z;
+            self.set_radius(i, *a);
+        }
+        for (i, f) in forces.unwrap_or_default().iter().enumerate() {
+            self.fx[i] = f.x;
+            self.fy[i] = f.y;
+            self.fz[i] = f.z;
+        }
     }
 
     /// Number of spheres.

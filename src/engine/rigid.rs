@@ -69,9 +69,9 @@ impl RigidSystem {
         self.spheres.block_apply(alpha, beta, v)
     }
 
-    /// Put the swimmers in the periodic box of `ewald` (its sums give the mobility).
-    pub fn set_periodic(&mut self, ewald: Option<crate::engine::ewald::Ewald>) {
-        self.spheres.set_periodic(ewald);
+    /// Take `operator` as the boundary's mobility (open space until set).
+    pub fn set_mobility(&mut self, operator: Box<dyn crate::engine::mobility::MobilityOperator>) {
+        self.spheres.set_mobility(operator);
     }
 
     /// The constraint tensions at time `t` (N), in swimmer order.

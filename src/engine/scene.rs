@@ -16,8 +16,9 @@ use super::error::{
 use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_FROM_SPHERES};
 use super::integrators::{IntegratorSpec, OdeSystem, Stats};
 use super::micro::MicroSystem;
-use super::mobility::Mobility;
+use super::mobility::{Mobility, MobilityOperator};
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
+use super::open_space::OpenSpace;
 use super::periodic::{separation, PeriodicBox};
 use super::rigid::RigidSystem;
 use super::swimmer::{unit_direction, Dumbbell};
@@ -368,6 +369,23 @@ impl Scene {
         self.ewald_by(self.ewald_method)
     }
 
+    /// The boundary's mobility for the sphere models: the box's Ewald sums with products by
+    /// `method` (blocks and matrices are Beenakker's either way), or open space.
+    pub(crate) fn mobility_operator_by(
+        &self,
+        method: EwaldMethod,
+    ) -> Result<Box<dyn MobilityOperator>> {
+        Ok(match self.ewald_by(method)? {
+            Some(e) => Box::new(e),
+            None => Box::new(OpenSpace::new(self.mu, self.mobility)),
+        })
+    }
+
+    /// The boundary's mobility with the scene's Ewald method.
+    pub(crate) fn mobility_operator(&self) -> Result<Box<dyn MobilityOperator>> {
+        self.mobility_operator_by(self.ewald_method)
+    }
+
     /// The box's periodic mobility with products by `method`.
     pub(crate) fn ewald_by(&self, method: EwaldMethod) -> Result<Option<Ewald>> {
         self.periodic
@@ -560,12 +578,8 @@ impl Scene {
             radii.extend([d.a1, d.a2]);
         }
         let mut v = vec![Vector3::zeros(); n];
-        match self.ewald()? {
-            Some(e) => e.interaction_velocities(&pos, &radii, forces, &mut v),
-            None => self
-                .mobility
-                .interaction_velocities(self.mu, &pos, &radii, forces, &mut v),
-        }
+        self.mobility_operator()?
+            .interaction_velocities(&pos, &radii, forces, &mut v);
         for ((vi, f), a) in v.iter_mut().zip(forces).zip(&radii) {
             *vi += f * super::mobility::self_mobility(self.mu, *a);
         }

@@ -3,10 +3,10 @@
 //! Sphere 2σ is dumbbell σ's a1 sphere, 2σ+1 its a2 sphere.
 
 use super::contacts::Contacts;
-use super::ewald::Ewald;
 use super::integrators::Problem;
-use super::mobility::{self_mobility, Mobility};
-use super::pairs::{self, SoaSpheres};
+use super::mobility::{self_mobility, Mobility, MobilityOperator};
+use super::open_space::{OpenSpace, FAST_KERNEL_SPHERES, PARALLEL_SPHERES};
+use super::pairs::SoaSpheres;
 use super::periodic::{separation, PeriodicBox};
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
@@ -15,6 +15,8 @@ use nalgebra::Vector3;
 #[derive(Debug, Clone)]
 pub(crate) struct Spheres {
     pub(crate) mu: f64,
+    /// The pair tensor of each dumbbell's own stiff part in the Jacobians (open space's: a box's
+    /// images, smooth over a dumbbell's length, stay with the explicit rates).
     pub(crate) mobility: Mobility,
     pub(crate) radii: Vec<f64>,
     /// Positions (m), filled by the model before [`Spheres::interact`].
@@ -27,19 +29,12 @@ pub(crate) struct Spheres {
     steric: Vec<Vector3<f64>>,
     contacts: Contacts,
     u: Vec<Vector3<f64>>,
-    /// Scratch of the fast kernel (large scenes).
+    /// Scratch of the gap passes (large scenes).
     soa: SoaSpheres,
-    soa_u: Vec<[f64; 3]>,
-    /// In a periodic box: the Ewald-summed mobility (its box also sets the minimum images).
-    ewald: Option<Ewald>,
+    /// The boundary's mobility: open space, or a periodic box's Ewald sums (whose box also sets
+    /// the minimum images).
+    operator: Box<dyn MobilityOperator>,
 }
-
-/// From this many spheres on, the vectorised row kernel ([`pairs`]) replaces the symmetric
-/// half-loop (below it the half-loop's halved arithmetic wins; measured in `benches/kernels.rs`).
-pub const FAST_KERNEL_SPHERES: usize = 64;
-/// From this many spheres on, the rows run in parallel (a product costs ≳ 0.3 ms, far above
-/// rayon's few-µs dispatch).
-pub const PARALLEL_SPHERES: usize = 256;
 
 impl Spheres {
     /// Spheres of these dumbbells in a fluid of viscosity `mu`.
@@ -64,40 +59,31 @@ impl Spheres {
             contacts,
             u: vec![Vector3::zeros(); n],
             soa: SoaSpheres::default(),
-            soa_u: Vec::new(),
-            ewald: None,
+            operator: Box::new(OpenSpace::new(mu, mobility)),
         }
     }
 
-    /// Put the spheres in the periodic box of `ewald`, whose sums then give the mobility.
-    pub(crate) fn set_periodic(&mut self, ewald: Option<Ewald>) {
-        self.soa.periodic = ewald.as_ref().map(|e| *e.periodic());
-        self.ewald = ewald;
+    /// Take `operator` as the boundary's mobility (open space until set).
+    pub(crate) fn set_mobility(&mut self, operator: Box<dyn MobilityOperator>) {
+        self.soa.periodic = operator.periodic().copied();
+        self.operator = operator;
     }
 
     /// The periodic box, if any.
     pub(crate) fn periodic(&self) -> Option<&PeriodicBox> {
-        self.ewald.as_ref().map(Ewald::periodic)
+        self.operator.periodic()
     }
 
-    /// H_αβ v for spheres α, β (α = β: the self block, Stokes drag included), with the box's
-    /// periodic mobility in a box.
+    /// H_αβ v for spheres α, β (α = β: the self block, Stokes drag included).
     pub(crate) fn block_apply(&self, alpha: usize, beta: usize, v: &Vector3<f64>) -> Vector3<f64> {
-        let r = self.pos[alpha] - self.pos[beta];
         let (ai, aj) = (self.radii[alpha], self.radii[beta]);
-        match &self.ewald {
-            Some(e) => e.block(&e.periodic().min_image(r), ai, aj, alpha == beta) * v,
-            None if alpha == beta => v * self_mobility(self.mu, ai),
-            None => self.mobility.pair_apply(self.mu, &r, ai, aj, v),
-        }
+        let (xa, xb) = (&self.pos[alpha], &self.pos[beta]);
+        self.operator.block(xa, xb, ai, aj, alpha == beta) * v
     }
 
-    /// The full mobility matrix at the current positions (the box's periodic one in a box).
+    /// The full mobility matrix at the current positions.
     pub(crate) fn mobility_matrix(&self) -> nalgebra::DMatrix<f64> {
-        match &self.ewald {
-            Some(e) => e.matrix(&self.pos, &self.radii),
-            None => self.mobility.matrix(self.mu, &self.pos, &self.radii),
-        }
+        self.operator.matrix(&self.pos, &self.radii)
     }
 
     /// Put force `f(σ)` on sphere 1 and −f(σ) on sphere 2 of every dumbbell (each dumbbell is
@@ -119,7 +105,7 @@ impl Spheres {
             st.add_forces(
                 &self.pos,
                 &self.radii,
-                self.ewald.as_ref().map(Ewald::periodic),
+                self.operator.periodic(),
                 &mut self.steric,
                 n >= PARALLEL_SPHERES,
             );
@@ -146,50 +132,10 @@ impl Spheres {
         }
     }
 
-    /// u_α = Σ_{β≠α} H_αβ F_β for the forces set.
+    /// u_α = (W F)_α for the forces set: every velocity beyond each sphere's Stokes drag.
     fn pair_velocities(&mut self) {
-        let n = self.pos.len();
-        if let Some(e) = &self.ewald {
-            e.interaction_velocities(&self.pos, &self.radii, &self.forces, &mut self.u);
-            return;
-        }
-        if n < FAST_KERNEL_SPHERES {
-            self.mobility.interaction_velocities(
-                self.mu,
-                &self.pos,
-                &self.radii,
-                &self.forces,
-                &mut self.u,
-            );
-            return;
-        }
-        self.fill_soa();
-        self.soa_u.resize(n, [0.0; 3]);
-        pairs::interaction_velocities(
-            self.mobility,
-            self.mu,
-            &self.soa,
-            &mut self.soa_u,
-            n >= PARALLEL_SPHERES,
-        );
-        for (u, v) in self.u.iter_mut().zip(&self.soa_u) {
-            *u = Vector3::new(v[0], v[1], v[2]);
-        }
-    }
-
-    fn fill_soa(&mut self) {
-        let n = self.pos.len();
-        let s = &mut self.soa;
-        s.resize(n);
-        for (i, (p, f)) in self.pos.iter().zip(&self.forces).enumerate() {
-            s.x[i] = p.x;
-            s.y[i] = p.y;
-            s.z[i] = p.z;
-            s.set_radius(i, self.radii[i]);
-            s.fx[i] = f.x;
-            s.fy[i] = f.y;
-            s.fz[i] = f.z;
-        }
+        self.operator
+            .interaction_velocities(&self.pos, &self.radii, &self.forces, &mut self.u);
     }
 
     /// The force on sphere 1 of dumbbell `s` set by the last [`Spheres::interact`].
@@ -223,7 +169,7 @@ impl Spheres {
             });
         }
         if self.pos.len() >= FAST_KERNEL_SPHERES {
-            self.fill_soa();
+            self.soa.fill(&self.pos, &self.radii, None);
             let parallel = self.pos.len() >= PARALLEL_SPHERES;
             return super::gaps::closest_overlap(&self.soa, &self.radii, parallel)
                 .map(|(gap, a, b)| overlap_problem(gap, a, b));

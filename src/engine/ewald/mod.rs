@@ -24,7 +24,7 @@
 
 use super::choice::{self, Choice, Named};
 use super::error::{invalid, unsupported, Result, Setting};
-use super::mobility::{self_mobility, Mobility};
+use super::mobility::{self_mobility, Mobility, MobilityOperator};
 use super::periodic::{PeriodicBox, WavePhases};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
@@ -580,5 +580,40 @@ mod tests {
                 }
             }
         }
+    }
+}
+
+impl MobilityOperator for Ewald {
+    fn interaction_velocities(
+        &mut self,
+        pos: &[Vector3<f64>],
+        radii: &[f64],
+        forces: &[Vector3<f64>],
+        out: &mut [Vector3<f64>],
+    ) {
+        Ewald::interaction_velocities(self, pos, radii, forces, out);
+    }
+
+    fn block(
+        &self,
+        xa: &Vector3<f64>,
+        xb: &Vector3<f64>,
+        ai: f64,
+        aj: f64,
+        same: bool,
+    ) -> Matrix3<f64> {
+        Ewald::block(self, &self.periodic.min_image(xa - xb), ai, aj, same)
+    }
+
+    fn matrix(&self, pos: &[Vector3<f64>], radii: &[f64]) -> DMatrix<f64> {
+        Ewald::matrix(self, pos, radii)
+    }
+
+    fn periodic(&self) -> Option<&PeriodicBox> {
+        Some(&self.periodic)
+    }
+
+    fn boxed(&self) -> Box<dyn MobilityOperator> {
+        Box::new(self.clone())
     }
 }

@@ -74,7 +74,7 @@ impl Scene {
                     self.contacts,
                 );
                 sys.set_thermal(self.thermal);
-                sys.set_periodic(self.ewald()?);
+                sys.set_mobility(self.mobility_operator()?);
                 Box::new(sys)
             }
             Model::Rigid => {
@@ -110,7 +110,7 @@ impl Scene {
             self.contacts.allow_overlap,
         );
         // The constraint solve takes blocks, which are Beenakker's sums.
-        sys.set_periodic(self.ewald_by(EwaldMethod::Beenakker)?);
+        sys.set_mobility(self.mobility_operator_by(EwaldMethod::Beenakker)?);
         Ok(sys)
     }
 
