@@ -554,35 +554,6 @@ pub fn hasimoto(mu: f64, a: f64, l: f64) -> f64 {
     self_mobility(mu, a) * (1.0 - 2.837_297_479_4 * x + 4.0 * PI / 3.0 * x.powi(3))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn cube(l: f64) -> PeriodicBox {
-        PeriodicBox::new([l; 3]).unwrap()
-    }
-
-    /// A lone sphere's periodic self-mobility is Hasimoto's, whatever the splitting and size.
-    /// The tolerance, 1e-10, is the sums' (1e-13) times the ~1e3 terms rounding adds up.
-    #[test]
-    fn lone_sphere_is_hasimoto() {
-        let (mu, l) = (1e-3, 10e-6);
-        for x in [0.02, 0.1, 0.2] {
-            for xi in [0.5, 1.0, 3.0] {
-                let a = x * l;
-                let split = Some(xi * PI.sqrt() / l);
-                let e = Ewald::new(cube(l), mu, Mobility::Rpy, 1, 1e-13, split).unwrap();
-                let m = e.block(&Vector3::zeros(), a, a, true);
-                let want = hasimoto(mu, a, l);
-                for q in 0..3 {
-                    let err = (m[(q, q)] / want - 1.0).abs();
-                    assert!(err < 1e-10, "a/L {x}, xi L {xi}: relative error {err:e}");
-                }
-            }
-        }
-    }
-}
-
 impl MobilityOperator for Ewald {
     fn interaction_velocities(
         &mut self,
@@ -615,5 +586,34 @@ impl MobilityOperator for Ewald {
 
     fn boxed(&self) -> Box<dyn MobilityOperator> {
         Box::new(self.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(l: f64) -> PeriodicBox {
+        PeriodicBox::new([l; 3]).unwrap()
+    }
+
+    /// A lone sphere's periodic self-mobility is Hasimoto's, whatever the splitting and size.
+    /// The tolerance, 1e-10, is the sums' (1e-13) times the ~1e3 terms rounding adds up.
+    #[test]
+    fn lone_sphere_is_hasimoto() {
+        let (mu, l) = (1e-3, 10e-6);
+        for x in [0.02, 0.1, 0.2] {
+            for xi in [0.5, 1.0, 3.0] {
+                let a = x * l;
+                let split = Some(xi * PI.sqrt() / l);
+                let e = Ewald::new(cube(l), mu, Mobility::Rpy, 1, 1e-13, split).unwrap();
+                let m = e.block(&Vector3::zeros(), a, a, true);
+                let want = hasimoto(mu, a, l);
+                for q in 0..3 {
+                    let err = (m[(q, q)] / want - 1.0).abs();
+                    assert!(err < 1e-10, "a/L {x}, xi L {xi}: relative error {err:e}");
+                }
+            }
+        }
     }
 }
