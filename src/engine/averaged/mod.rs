@@ -10,18 +10,26 @@
 //! What a scene does not need is skipped: pairs with sin(φσ−φρ) = 0, the I and K terms of symmetric
 //! swimmers, and for an aligned scene the 3D algebra (the 1D reduction e:stroke_averaged).
 //!
-//! The terms, their shortcuts, the row loop over structure-of-arrays and its cutoff and contact
-//! guard live here; the all-pairs rows in vector lanes in `lanes`; a cutoff's rows over neighbour
-//! lists in `list_rows`, and the lists' upkeep, steric forces and contact guard in `listed`.
+//! The system's state, its shortcuts and the row loop over structure-of-arrays live here; the
+//! per-swimmer constants, the cutoff's switch and a pair's phase weight in `terms`; the
+//! `OdeSystem` (rates, guards, noise, projection) in `ode`; the all-pairs rows in vector lanes in
+//! `lanes`; a cutoff's rows over neighbour lists in `list_rows`, and the lists' upkeep, steric
+//! forces and contact guard in `listed`.
 //! tests/averaged_model.rs compares every shortcut with the general 3D sum.
 
 mod implicit;
 mod lanes;
 mod list_rows;
 mod listed;
+mod ode;
 mod partitioned;
+mod terms;
 
 pub use implicit::{CONTACT_MARGIN_OF_RANGE, DISPLACEMENT_FLOOR, MAX_CLUSTER_SWIMMERS};
+use ode::shared_centre_problem;
+pub(crate) use terms::pair_constants;
+use terms::{pair_weight, Coef};
+pub use terms::{CutoffSwitch, CUTOFF_SWITCH_WIDTH};
 
 use super::contacts::Contacts;
 use super::integrators::{GroupJacobian, Noise, OdeSystem, Partitioned, Problem};
@@ -67,102 +75,6 @@ impl Shortcuts {
             skip_symmetric_terms: false,
             aligned_1d: false,
         }
-    }
-}
-
-/// Per-swimmer constants of the averaged equations.
-#[derive(Debug, Clone, Copy)]
-struct Coef {
-    /// Weight of the I term (A_R).
-    a_r: f64,
-    /// Weight of the J term (c_J).
-    c_j: f64,
-    /// Weight of the K term (A_N).
-    a_n: f64,
-    /// Λω (λ/ℓ)² (m/s): common prefactor of I and J.
-    v0: f64,
-    /// ω (λ/ℓ)² (1/s): common prefactor of K and L.
-    w0: f64,
-    /// Λ/ℓ.
-    big_l: f64,
-    ell: f64,
-    phase: f64,
-}
-
-impl Coef {
-    fn new(d: &Dumbbell, set: Coefficients) -> Self {
-        let (a1, a2) = (d.a1, d.a2);
-        let (a_r, c_j) = match set {
-            Coefficients::Paper => ((a2 * a2 - a1 * a1) / (a1 * a1 + a2 * a2), 1.0),
-            Coefficients::LeadingOrder => (
-                (a2 - a1) / (a1 + a2),
-                4.0 * a1 * a2 / ((a1 + a2) * (a1 + a2)),
-            ),
-        };
-        let eps2 = (d.lambda / d.ell).powi(2);
-        Coef {
-            a_r,
-            c_j,
-            a_n: (a2 - a1) / (a1 + a2),
-            v0: d.big_lambda() * d.omega * eps2,
-            w0: d.omega * eps2,
-            big_l: d.big_lambda() / d.ell,
-            ell: d.ell,
-            phase: d.phase,
-        }
-    }
-}
-
-/// A swimmer's constants as the GPU kernel reads them: A_R, c_J, A_N, v0, w0, Λ/ℓ, ℓ, φ.
-pub(crate) fn pair_constants(d: &Dumbbell, set: Coefficients) -> [f64; 8] {
-    let c = Coef::new(d, set);
-    [c.a_r, c.c_j, c.a_n, c.v0, c.w0, c.big_l, c.ell, c.phase]
-}
-
-/// The far-field cutoff's switch, as a fraction of the cutoff D_c: see [`CutoffSwitch`].
-pub const CUTOFF_SWITCH_WIDTH: f64 = 0.1;
-
-/// The far-field cutoff's switch: a pair's terms are weighed by S(D) = 1 below (1 − w)D_c, 0 from
-/// D_c on, and between them the smoothstep S = 1 − x⁴(35 − 84x + 70x² − 20x³),
-/// x = (D − (1 − w)D_c)/(w D_c), whose first three derivatives vanish at both ends (w =
-/// [`CUTOFF_SWITCH_WIDTH`]). The rates are then three times continuously differentiable as
-/// pairs cross the cutoff: the integrators keep their orders (RK4's needs that much) and their
-/// error estimates stay meaningful, where a pair leaving at once would jump the rates and stall
-/// every adaptive step that straddles the crossing.
-#[derive(Debug, Clone, Copy)]
-pub struct CutoffSwitch {
-    /// (1 − w) D_c (m); 0 without a cutoff.
-    inner: f64,
-    /// 1/(w D_c) (1/m); 0 without a cutoff (every pair weighs 1).
-    inv_width: f64,
-}
-
-impl CutoffSwitch {
-    fn new(cutoff: Option<f64>) -> Self {
-        match cutoff {
-            Some(c) if c.is_finite() => CutoffSwitch {
-                inner: (1.0 - CUTOFF_SWITCH_WIDTH) * c,
-                inv_width: 1.0 / (CUTOFF_SWITCH_WIDTH * c),
-            },
-            _ => CutoffSwitch {
-                inner: 0.0,
-                inv_width: 0.0,
-            },
-        }
-    }
-
-    /// S(D) for a pair at distance `d` (m, finite).
-    #[inline(always)]
-    pub fn at(&self, d: f64) -> f64 {
-        let x = ((d - self.inner) * self.inv_width).clamp(0.0, 1.0);
-        let x2 = x * x;
-        let p = x.mul_add(x.mul_add((-20.0f64).mul_add(x, 70.0), -84.0), 35.0);
-        (-(x2 * x2)).mul_add(p, 1.0)
-    }
-
-    /// Where the switch starts, (1 − w) D_c (m): pairs beyond weigh less than 1.
-    pub fn inner(&self) -> f64 {
-        self.inner
     }
 }
 
@@ -668,207 +580,5 @@ impl AveragedSystem {
                 .enumerate()
                 .for_each(|(s, out)| one(s, out));
         }
-    }
-}
-
-impl OdeSystem for AveragedSystem {
-    fn dim(&self) -> usize {
-        STATE_PER_SWIMMER * self.coef.len()
-    }
-
-    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
-        match self.axis {
-            Some(axis) => {
-                // Centre coordinates along the axis in `x`, the orientation's in `nx`.
-                for s in 0..self.coef.len() {
-                    self.soa.x[s] = self.center(y, s).dot(&axis);
-                    self.soa.nx[s] = vec3(y, STATE_PER_SWIMMER * s + 3).dot(&axis);
-                }
-            }
-            None => self.fill(y),
-        }
-        if self.uses_lists() {
-            self.update_list();
-            if let Some(st) = self.contacts.steric {
-                self.steric_by_list(st);
-            }
-            return self.rows_by_list(dy);
-        }
-        if let Some(st) = self.contacts.steric {
-            // The sphere models' pair force, on the spheres at length ℓ.
-            self.steric_f.fill(Vector3::zeros());
-            let parallel = self.coef.len() >= PARALLEL_SWIMMERS;
-            let periodic = self.periodic.as_ref();
-            st.add_forces(
-                &self.sphere_pos,
-                &self.radii,
-                periodic,
-                &mut self.steric_f,
-                parallel,
-            );
-        }
-        self.rows_into(y, dy);
-    }
-
-    fn autonomous(&self) -> bool {
-        true
-    }
-
-    fn stiff_groups(&mut self, _t: f64, y: &[f64]) -> GroupJacobian {
-        self.contact_jacobian(y)
-    }
-
-    fn step_error_norm(
-        &self,
-        _y: &[f64],
-        _y_new: &[f64],
-        err: &[f64],
-        h: f64,
-        f0: &[f64],
-        tol: f64,
-    ) -> f64 {
-        let mut e = vec![0.0; self.coef.len()];
-        self.swimmer_errors(err, h, f0, tol, None, &mut None, &mut e);
-        (e.iter().map(|e| e * e).sum::<f64>() / e.len().max(1) as f64).sqrt()
-    }
-
-    fn as_partitioned(&mut self) -> Option<&mut dyn Partitioned> {
-        Some(self)
-    }
-
-    /// Centres against the closest pair's per-period drift scale (as in the microscopic model),
-    /// orientations against the matching rotation scale (λ/ℓ)²(Λ/ℓ).
-    fn error_scale(&self, _y: &[f64], scale: &mut [f64]) {
-        for s in 0..self.coef.len() {
-            let i = STATE_PER_SWIMMER * s;
-            scale[i..i + 3].fill(self.scale_r[s]);
-            scale[i + 3..i + 6].fill(self.scale_n[s]);
-        }
-    }
-
-    fn check(&mut self, _t: f64, y: &[f64]) -> Result<(), Problem> {
-        self.fill(y);
-        if self.uses_lists() {
-            self.update_list();
-            return self.check_by_list();
-        }
-        let soa = &self.soa;
-        let n = self.coef.len();
-        let parallel = n >= PARALLEL_SWIMMERS;
-        let shared_centre = |s: usize| {
-            (s + 1..n)
-                .find(|&r| {
-                    soa.x[s] == soa.x[r]
-                        && soa.y[s] == soa.y[r]
-                        && soa.z[s] == soa.z[r]
-                        && self.pair_sin(s, r).is_some()
-                })
-                .map(|r| (s, r))
-        };
-        let found = if n >= LIST_SWIMMERS {
-            // Only swimmers with bitwise equal centres share one: group them, O(S).
-            let mut groups: std::collections::HashMap<[u64; 3], Vec<usize>> =
-                std::collections::HashMap::new();
-            for i in 0..n {
-                // + 0.0 makes −0.0 the key of 0.0, as == treats them.
-                let key = [soa.x[i], soa.y[i], soa.z[i]].map(|c| (c + 0.0).to_bits());
-                groups.entry(key).or_default().push(i);
-            }
-            groups
-                .values()
-                .filter(|g| g.len() > 1)
-                .flat_map(|g| {
-                    g.iter()
-                        .enumerate()
-                        .flat_map(move |(k, &s)| g[k + 1..].iter().map(move |&r| (s, r)))
-                })
-                .filter(|&(s, r)| self.pair_sin(s, r).is_some())
-                .min()
-        } else if parallel {
-            (0..n).into_par_iter().find_map_first(shared_centre)
-        } else {
-            (0..n).find_map(shared_centre)
-        };
-        if let Some((s, r)) = found {
-            return Err(shared_centre_problem(s, r));
-        }
-        if self.contacts.allow_overlap {
-            return Ok(());
-        }
-        // The sphere models' contact guard, on the spheres at length ℓ.
-        let g = &mut self.gap_soa;
-        g.resize(self.sphere_pos.len());
-        for (i, p) in self.sphere_pos.iter().enumerate() {
-            (g.x[i], g.y[i], g.z[i]) = (p.x, p.y, p.z);
-        }
-        match super::gaps::closest_overlap(g, &self.radii, parallel) {
-            Some((gap, a, b)) => Err(super::spheres::overlap_problem(gap, a, b)),
-            None => Ok(()),
-        }
-    }
-
-    fn noise(&self) -> Option<Noise> {
-        self.thermal.as_ref().map(|(seed, _)| Noise {
-            seed: *seed,
-            dim: STATE_PER_SWIMMER * self.coef.len(),
-        })
-    }
-
-    /// Each swimmer's centre of mobility C = R_H + z_c N takes a step √(2D_∥)(N·ξ)N +
-    /// √(2D_⊥)(1 − NNᵀ)ξ, its orientation turns to (N + √(2D_r)(1 − NNᵀ)ξ')/|…| (the
-    /// normalisation carries the Itô drift −2D_r N dt of rotational diffusion), and R_H = C − z_c N
-    /// follows: translation and rotation are independent about C, not about R_H.
-    fn add_noise(
-        &mut self,
-        _t: f64,
-        y: &[f64],
-        dw: &[f64],
-        y_new: &mut [f64],
-    ) -> Result<(), Problem> {
-        let Some((_, diffusion)) = &self.thermal else {
-            return Ok(());
-        };
-        for (s, d) in diffusion.iter().enumerate() {
-            let i = STATE_PER_SWIMMER * s;
-            let n = vec3(y, i + 3).normalize();
-            let (xi, xr) = (vec3(dw, i), vec3(dw, i + 3));
-            let along = n * n.dot(&xi);
-            let dc =
-                (2.0 * d.parallel).sqrt() * along + (2.0 * d.perpendicular).sqrt() * (xi - along);
-            let n_det = vec3(y_new, i + 3).normalize();
-            let turned = (vec3(y_new, i + 3) + (2.0 * d.rotation).sqrt() * (xr - n * n.dot(&xr)))
-                .normalize();
-            let r = vec3(y_new, i) + dc - d.offset * (turned - n_det);
-            set_vec3(y_new, i, &r);
-            set_vec3(y_new, i + 3, &turned);
-        }
-        Ok(())
-    }
-
-    /// Renormalise every N (the projector keeps dN/dt tangent; the step leaves it off by O(h²)).
-    fn project(&self, y: &mut [f64]) {
-        for s in 0..self.coef.len() {
-            let i = STATE_PER_SWIMMER * s + 3;
-            let n = vec3(y, i).normalize();
-            set_vec3(y, i, &n);
-        }
-    }
-}
-
-/// sin(φσ − φρ) from the phases' sines and cosines if the pair interacts: not the same swimmer,
-/// and not a zero phase difference when `skip_zero` (the neighbour lists' pair weight).
-#[inline]
-fn pair_weight(sin: &[f64], cos: &[f64], skip_zero: bool, s: usize, r: usize) -> Option<f64> {
-    let v = sin[s] * cos[r] - cos[s] * sin[r];
-    (s != r && (v.abs() > SIN_ZERO || !skip_zero)).then_some(v)
-}
-
-/// The guard's error for swimmers `s` and `r` at the same centre.
-fn shared_centre_problem(s: usize, r: usize) -> Problem {
-    Problem {
-        swimmer: Some(s),
-        cause: format!("swimmers {s} and {r} have the same centre"),
-        hint: "start the swimmers apart: the averaged model is a far-field model".into(),
-        fixes: Vec::new(),
     }
 }
