@@ -1,0 +1,262 @@
+//! The steric repulsion between rods: each swimmer's body as the segment between its sphere
+//! centres with its radii at the ends, the rods' contact points (blended near parallel so the
+//! torque turns smoothly through it) and the pair forces and torques that follow.
+
+use super::*;
+
+/// A rod: its start, the vector from start to end, and its radii at the two ends.
+pub(super) type Rod = (Vector3<f64>, Vector3<f64>, [f64; 2]);
+
+impl Steric {
+    /// The repulsion between the rods of swimmers `i` and `j` (spheres 2i, 2i+1 and 2j, 2j+1):
+    /// the closest points of the two axes, at fractions s and t along them, and the force on
+    /// rod `i` there, F = k (δ − gap) r̂ with gap = |r| − a_i(s) − a_j(t), the radii interpolated
+    /// linearly between the spheres'. `None` when out of reach (or the axes cross exactly).
+    #[inline]
+    pub(super) fn rod_force(
+        &self,
+        pos: &[Vector3<f64>],
+        radii: &[f64],
+        periodic: Option<&PeriodicBox>,
+        i: usize,
+        j: usize,
+    ) -> Option<(f64, Vector3<f64>)> {
+        let (p, d1) = (pos[2 * i], pos[2 * i + 1] - pos[2 * i]);
+        // Rod j moved to its image nearest rod i (midpoints by the minimum image; open space: 0).
+        let mid = |k: usize| (pos[2 * k] + pos[2 * k + 1]) * 0.5;
+        let d = mid(i) - mid(j);
+        let shift = d - separation(periodic, d);
+        let (q, d2) = (pos[2 * j] + shift, pos[2 * j + 1] - pos[2 * j]);
+        self.rod_pair_force(
+            (p, d1, [radii[2 * i], radii[2 * i + 1]]),
+            (q, d2, [radii[2 * j], radii[2 * j + 1]]),
+        )
+    }
+
+    /// The repulsion between rod `a` = (start, start-to-end, radii at both ends) and rod `b`, as
+    /// [`Steric::rod_force`]: the fraction s along `a` where it acts and the force on `a`.
+    #[inline]
+    pub(crate) fn rod_pair_force(&self, a: Rod, b: Rod) -> Option<(f64, Vector3<f64>)> {
+        self.rod_pair_force_within(a, b, 0.0)
+    }
+
+    /// [`Steric::rod_pair_force`] carried on to gaps of δ + `extra`, as
+    /// [`Steric::sphere_force_within`].
+    #[inline]
+    pub(super) fn rod_pair_force_within(
+        &self,
+        a: Rod,
+        b: Rod,
+        extra: f64,
+    ) -> Option<(f64, Vector3<f64>)> {
+        let ((p, d1, ra), (q, d2, rb)) = (a, b);
+        let (s, t) = contact_points(&p, &d1, &q, &d2);
+        let r = (p + d1 * s) - (q + d2 * t);
+        let reach = self.range + (1.0 - s) * ra[0] + s * ra[1] + (1.0 - t) * rb[0] + t * rb[1];
+        let limit = reach + extra;
+        let d2r = r.norm_squared();
+        (d2r < limit * limit && d2r > 0.0).then(|| {
+            let d = d2r.sqrt();
+            (
+                s,
+                r * (self.stiffness * self.law.force(reach - d, self.range) / d),
+            )
+        })
+    }
+
+    /// The forces on swimmer A's two spheres (centres `a`, radii `ra`) from swimmer B's (`b`,
+    /// `rb`; B already at the image A meets), as [`Steric::add_forces`] adds them for this
+    /// body: per sphere pair, or rod to rod, the rod's force shared by its spheres.
+    #[inline]
+    pub(crate) fn swimmer_pair_forces(
+        &self,
+        a: [Vector3<f64>; 2],
+        ra: [f64; 2],
+        b: [Vector3<f64>; 2],
+        rb: [f64; 2],
+    ) -> [Vector3<f64>; 2] {
+        self.swimmer_pair_forces_within(a, ra, b, rb, 0.0)
+    }
+
+    /// [`Steric::swimmer_pair_forces`] with the force law carried on to gaps of δ + `extra`.
+    #[inline]
+    pub(crate) fn swimmer_pair_forces_within(
+        &self,
+        a: [Vector3<f64>; 2],
+        ra: [f64; 2],
+        b: [Vector3<f64>; 2],
+        rb: [f64; 2],
+        extra: f64,
+    ) -> [Vector3<f64>; 2] {
+        let mut f = [Vector3::zeros(); 2];
+        match self.body {
+            StericBody::Spheres => {
+                for k in 0..2 {
+                    for m in 0..2 {
+                        if let Some(df) = self.sphere_force_within(a[k] - b[m], ra[k], rb[m], extra)
+                        {
+                            f[k] += df;
+                        }
+                    }
+                }
+            }
+            StericBody::Rods => {
+                if let Some((s, df)) = self.rod_pair_force_within(
+                    (a[0], a[1] - a[0], ra),
+                    (b[0], b[1] - b[0], rb),
+                    extra,
+                ) {
+                    f[0] += df * (1.0 - s);
+                    f[1] += df * s;
+                }
+            }
+        }
+        f
+    }
+
+    /// [`Steric::add_forces`] between rods: the force on a rod at fraction s along it goes
+    /// (1 − s) to its first sphere and s to its second, which carries its force and torque about
+    /// any point. Each swimmer sums its partners in index order; from [`super::super::gaps::CELL_LIST_SPHERES`]
+    /// spheres the partners come from cell lists of the midpoints (side: range + twice the
+    /// largest radius + the longest rod), bitwise the same forces.
+    pub(super) fn add_rod_forces(
+        &self,
+        pos: &[Vector3<f64>],
+        radii: &[f64],
+        periodic: Option<&PeriodicBox>,
+        forces: &mut [Vector3<f64>],
+        parallel: bool,
+    ) {
+        let swimmers = pos.len() / 2;
+        let longest = (0..swimmers)
+            .map(|k| (pos[2 * k + 1] - pos[2 * k]).norm())
+            .fold(0.0, f64::max);
+        let reach_max = self.range + 2.0 * radii.iter().copied().fold(0.0, f64::max) + longest;
+        let fits = periodic.is_none_or(|b| reach_max <= 0.5 * b.shortest());
+        let grid = (pos.len() >= super::super::gaps::CELL_LIST_SPHERES && fits && reach_max > 0.0)
+            .then(|| {
+                let mid = |d: usize| -> Vec<f64> {
+                    (0..swimmers)
+                        .map(|k| 0.5 * (pos[2 * k][d] + pos[2 * k + 1][d]))
+                        .collect()
+                };
+                super::super::cells::CellGrid::build_in(
+                    &mid(0),
+                    &mid(1),
+                    &mid(2),
+                    reach_max,
+                    periodic,
+                )
+            });
+        let row = |i: usize, f: &mut [Vector3<f64>]| {
+            let add = |j: usize| {
+                if let Some((s, df)) = self.rod_force(pos, radii, periodic, i, j) {
+                    f[0] += df * (1.0 - s);
+                    f[1] += df * s;
+                }
+            };
+            match &grid {
+                None => (0..swimmers).filter(|&j| j != i).for_each(add),
+                Some(grid) => {
+                    let m = (pos[2 * i] + pos[2 * i + 1]) * 0.5;
+                    let mut runs = Vec::with_capacity(27);
+                    grid.neighbour_runs(m.x, m.y, m.z, &mut runs);
+                    let mut near: Vec<usize> = runs
+                        .iter()
+                        .flat_map(|&(a, b)| grid.order[a as usize..b as usize].iter())
+                        .map(|&j| j as usize)
+                        .filter(|&j| j != i)
+                        .collect();
+                    near.sort_unstable();
+                    near.dedup();
+                    near.into_iter().for_each(add);
+                }
+            }
+        };
+        if parallel {
+            forces
+                .par_chunks_mut(2)
+                .enumerate()
+                .for_each(|(i, f)| row(i, f));
+        } else {
+            forces
+                .chunks_mut(2)
+                .enumerate()
+                .for_each(|(i, f)| row(i, f));
+        }
+    }
+}
+
+/// sin²θ below which two rods at angle θ act at points blended towards their overlap's middle
+/// (see [`contact_points`]): θ ≈ 5.7°.
+pub(super) const PARALLEL_BLEND_SIN2: f64 = 0.01;
+
+/// Where the repulsion between segments p + s d1 and q + t d2 acts: their closest points, except
+/// near parallel. There the closest points jump from one end to the other as the segments turn
+/// through parallel (at parallel they are not unique), and with them the torque; so within
+/// [`PARALLEL_BLEND_SIN2`] each point is drawn towards the middle of the part of its segment that
+/// faces the other, fully at parallel, by a weight χ(sin²θ) = 3u² − 2u³ (u = sin²θ /
+/// [`PARALLEL_BLEND_SIN2`]) whose derivative vanishes at both ends. The points are the same
+/// seen from either segment, so the pair forces stay equal and opposite along one line.
+pub(super) fn contact_points(
+    p: &Vector3<f64>,
+    d1: &Vector3<f64>,
+    q: &Vector3<f64>,
+    d2: &Vector3<f64>,
+) -> (f64, f64) {
+    let (s, t) = closest_on_segments(p, d1, q, d2);
+    let (a, e) = (d1.dot(d1), d2.dot(d2));
+    if a <= 0.0 || e <= 0.0 {
+        return (s, t);
+    }
+    let b = d1.dot(d2);
+    let u = ((a * e - b * b) / (a * e)).max(0.0) / PARALLEL_BLEND_SIN2;
+    if u >= 1.0 {
+        return (s, t);
+    }
+    let chi = u * u * (3.0 - 2.0 * u);
+    let r = p - q;
+    let (c, f) = (d1.dot(&r), d2.dot(&r));
+    // The other segment's ends projected onto each, clamped: the facing parts' middles.
+    let mid_s = 0.5 * ((-c / a).clamp(0.0, 1.0) + ((b - c) / a).clamp(0.0, 1.0));
+    let mid_t = 0.5 * ((f / e).clamp(0.0, 1.0) + ((b + f) / e).clamp(0.0, 1.0));
+    (mid_s + chi * (s - mid_s), mid_t + chi * (t - mid_t))
+}
+
+/// The fractions (s, t) ∈ [0, 1]² of the closest points of segments p + s·d1 and q + t·d2
+/// (Ericson, Real-Time Collision Detection, 5.1.9; parallel segments take s = 0 or the clamp).
+pub(super) fn closest_on_segments(
+    p: &Vector3<f64>,
+    d1: &Vector3<f64>,
+    q: &Vector3<f64>,
+    d2: &Vector3<f64>,
+) -> (f64, f64) {
+    let r = p - q;
+    let (a, e, f) = (d1.dot(d1), d2.dot(d2), d2.dot(&r));
+    if a <= 0.0 && e <= 0.0 {
+        return (0.0, 0.0);
+    }
+    if a <= 0.0 {
+        return (0.0, (f / e).clamp(0.0, 1.0));
+    }
+    let c = d1.dot(&r);
+    if e <= 0.0 {
+        return ((-c / a).clamp(0.0, 1.0), 0.0);
+    }
+    let b = d1.dot(d2);
+    let denom = a * e - b * b;
+    let mut s = if denom > 1e-14 * a * e {
+        ((b * f - c * e) / denom).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (b * s + f) / e;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-c / a).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((b - c) / a).clamp(0.0, 1.0);
+    }
+    (s, t)
+}
