@@ -4,7 +4,8 @@
 
 use nalgebra::Vector3;
 use swimlab::engine::build::{random_suspension, Orientations, Phases};
-use swimlab::engine::fields::{structure_factor, Field, FieldKind, FieldSpec, FieldStat};
+use swimlab::engine::fields::{Field, FieldKind, FieldSpec, FieldStat};
+use swimlab::engine::structure::structure_factor;
 use swimlab::engine::{Dumbbell, Model, Scene};
 
 /// A simple cubic lattice of n³ averaged swimmers filling a box of side `l`.

@@ -36,6 +36,7 @@ pub mod simd;
 pub mod simulation;
 mod spheres;
 pub mod stepping;
+pub mod structure;
 pub mod swimmer;
 pub mod thermal;
 pub mod trajectory;
