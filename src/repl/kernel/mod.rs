@@ -174,20 +174,7 @@ pub fn run(path: &Path) -> Result<(), String> {
         current: Mutex::new(None),
         shutdown: shutdown.clone(),
     });
-
-    // IOPub: publish in the order queued; after a shutdown, once the queue is empty, close
-    // (the socket's linger lets the last messages go out).
-    let key = conn.key.clone();
-    let publisher = std::thread::spawn(move || loop {
-        match rx.recv_timeout(Duration::from_millis(50)) {
-            Ok(m) => {
-                let _ = iopub.send_multipart(m.encode(&key), 0);
-            }
-            Err(std::sync::mpsc::RecvTimeoutError::Timeout) if !shutdown.load(Ordering::SeqCst) => {
-            }
-            Err(_) => break,
-        }
-    });
+    let publisher = spawn_publisher(iopub, rx, conn.key.clone(), shutdown);
     // Heartbeat: echo every ping.
     std::thread::spawn(move || {
         while let Ok(b) = hb.recv_bytes(0) {
@@ -202,6 +189,39 @@ pub fn run(path: &Path) -> Result<(), String> {
     let _keep_stdin = stdin;
 
     let mut session = Session::new();
+    route_output(&mut session, &shared);
+    serve(&mut session, &shell, &shared);
+    progress::set_sink(None);
+    console::set_sink(None);
+    console::set_display_sink(None);
+    console::set_note_sink(None);
+    let _ = publisher.join();
+    Ok(())
+}
+
+/// The IOPub thread: publish in the order queued; after a shutdown, once the queue is empty,
+/// close (the socket's linger lets the last messages go out).
+fn spawn_publisher(
+    iopub: zmq::Socket,
+    rx: std::sync::mpsc::Receiver<Message>,
+    key: Key,
+    shutdown: Arc<AtomicBool>,
+) -> std::thread::JoinHandle<()> {
+    std::thread::spawn(move || loop {
+        match rx.recv_timeout(Duration::from_millis(50)) {
+            Ok(m) => {
+                let _ = iopub.send_multipart(m.encode(&key), 0);
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) if !shutdown.load(Ordering::SeqCst) => {
+            }
+            Err(_) => break,
+        }
+    })
+}
+
+/// Everything a cell writes goes to IOPub as the cell's output: prints, display(value),
+/// text functions write themselves, notes and the progress display.
+fn route_output(session: &mut Session, shared: &Arc<Shared>) {
     let sh = shared.clone();
     session.on_print(move |s| {
         sh.publish_current(
@@ -248,26 +268,24 @@ pub fn run(path: &Path) -> Result<(), String> {
         );
     });
     progress::set_sink(Some(progress_sink));
+}
 
+/// The shell loop: each request marks the kernel busy, is handled, and marks it idle, until a
+/// shutdown.
+fn serve(session: &mut Session, shell: &zmq::Socket, shared: &Arc<Shared>) {
     let mut count = 0u64;
     shared.publish(None, "status", json!({"execution_state": "starting"}));
     while !shared.shutdown.load(Ordering::SeqCst) {
-        let Ok(Some(msg)) = shared.receive(&shell, "shell", 100) else {
+        let Ok(Some(msg)) = shared.receive(shell, "shell", 100) else {
             continue;
         };
         if let Ok(mut c) = shared.current.lock() {
             *c = Some(msg.clone());
         }
         shared.publish(Some(&msg), "status", json!({"execution_state": "busy"}));
-        handle_shell(&mut session, &shell, &shared, &msg, &mut count);
+        handle_shell(session, shell, shared, &msg, &mut count);
         shared.publish(Some(&msg), "status", json!({"execution_state": "idle"}));
     }
-    progress::set_sink(None);
-    console::set_sink(None);
-    console::set_display_sink(None);
-    console::set_note_sink(None);
-    let _ = publisher.join();
-    Ok(())
 }
 
 fn kernel_info() -> Value {
