@@ -506,7 +506,6 @@ impl Stepper for Stroboscopic {
             None => self.probed_slope(sys, t, y, stats)?,
         };
         let mut rejects = 0;
-        let mut heun_tried = self.heun_refused;
         loop {
             let m = match self.fixed {
                 Some(m) => m,
@@ -515,8 +514,7 @@ impl Stepper for Stroboscopic {
             // A step that ends the run first tries Heun's method: a slow motion over a short run
             // takes it at the price of one slope, where a rejection costs that slope only, once
             // a run.
-            if m == whole && self.fixed.is_none() && !heun_tried {
-                heun_tried = true;
+            if m == whole && self.fixed.is_none() && !self.heun_refused {
                 match self.heun_step(sys, t, y, &k1, m, stats) {
                     Some((y_new, e)) if e <= 1.0 => {
                         y.copy_from_slice(&y_new);
