@@ -37,6 +37,10 @@ pub enum Setting {
     EwaldMethod(&'static str),
     /// A looser tolerance of the box's Ewald sums.
     LooserEwaldTol,
+    /// No wall: open space.
+    NoWall,
+    /// No periodic box: open space.
+    NoBox,
 }
 
 impl std::fmt::Display for Setting {
@@ -64,6 +68,8 @@ impl std::fmt::Display for Setting {
             ),
             Setting::EwaldMethod(m) => write!(f, "the {m} Ewald method"),
             Setting::LooserEwaldTol => f.write_str("a looser tolerance of the Ewald sums (e.g. 1e-6)"),
+            Setting::NoWall => f.write_str("no wall"),
+            Setting::NoBox => f.write_str("no periodic box"),
         }
     }
 }

@@ -69,6 +69,11 @@ impl MicroSystem {
         self.spheres.set_mobility(operator);
     }
 
+    /// The constant external force on every sphere (N; none when empty).
+    pub fn set_external(&mut self, external: Vec<Vector3<f64>>) {
+        self.spheres.set_external(external);
+    }
+
     /// Thermal noise at `thermal`'s temperature (none at 0 K).
     pub fn set_thermal(&mut self, thermal: Thermal) {
         self.thermal = thermal.is_on().then_some(thermal);
@@ -146,6 +151,9 @@ impl OdeSystem for MicroSystem {
             let len = b.norm();
             swimmers[s].k0 * (len - rest[s]) / len * b
         });
+        if let Some(th) = self.thermal {
+            self.spheres.add_thermal_drift(th.kt());
+        }
         let sp = &self.spheres;
         for (s, d) in self.swimmers.iter().enumerate() {
             let drag = self_mobility(sp.mu, d.a1) + self_mobility(sp.mu, d.a2);

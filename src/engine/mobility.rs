@@ -187,6 +187,37 @@ pub trait MobilityOperator: std::fmt::Debug + Send + Sync {
     /// The full 3N×3N matrix M, self blocks included (dense noise roots, tests).
     fn matrix(&self, pos: &[Vector3<f64>], radii: &[f64]) -> DMatrix<f64>;
 
+    /// (∇·M)_α, the divergence of the mobility with respect to the positions, into `out`: the
+    /// drift kT ∇·M that Itô's thermal noise needs where M varies with the positions. `false`
+    /// (nothing written) where it vanishes, as in open space and a periodic box, or where the
+    /// boundary's settings leave the drift out.
+    fn divergence(&self, _pos: &[Vector3<f64>], _radii: &[f64], _out: &mut [Vector3<f64>]) -> bool {
+        false
+    }
+
+    /// Whether the boundary has a solid part (a wall) that repels spheres and that they must not
+    /// reach.
+    fn solid(&self) -> bool {
+        false
+    }
+
+    /// The sphere closest to a solid boundary and the gap between its surface and the boundary
+    /// (m); `None` where the boundary has no solid part.
+    fn boundary_gap(&self, _pos: &[Vector3<f64>], _radii: &[f64]) -> Option<(usize, f64)> {
+        None
+    }
+
+    /// Add the solid boundary's repulsion on each sphere to `forces`; `false` (nothing added)
+    /// where the boundary has no solid part.
+    fn add_boundary_forces(
+        &self,
+        _pos: &[Vector3<f64>],
+        _radii: &[f64],
+        _forces: &mut [Vector3<f64>],
+    ) -> bool {
+        false
+    }
+
     /// The periodic box, when the boundary is one (minimum images, gaps).
     fn periodic(&self) -> Option<&PeriodicBox> {
         None

@@ -17,6 +17,7 @@ pub mod error;
 pub mod ewald;
 pub mod fields;
 pub mod files;
+pub mod forces;
 pub mod gaps;
 pub mod gpu;
 pub mod integrators;
@@ -41,6 +42,7 @@ pub mod swimmer;
 pub mod thermal;
 pub mod trajectory;
 mod vtk;
+pub mod wall;
 
 pub use backend::Backend;
 pub use contacts::{Contacts, Overlaps, Steric, StericBody, StericLaw};

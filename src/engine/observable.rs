@@ -41,6 +41,13 @@ pub enum Observable {
     Nematic,
     /// The smallest gap between the surfaces of any two spheres of the scene (m).
     MinGap,
+    /// The smallest gap between a sphere's surface and the wall (m).
+    WallGap,
+    /// Height of swimmer i's hydrodynamic centre R_H above the wall (m).
+    Height(usize),
+    /// Angle of swimmer i's orientation N to the wall's plane (rad; positive pointing away from
+    /// the wall, in [−π/2, π/2]).
+    WallAngle(usize),
     /// Mean swimming speed ⟨|V|⟩ over the swimmers (m/s): V = dR_H/dt in the averaged model, the
     /// displacement of R_H over the next period / T in the sphere models (a probe run on a copy).
     MeanSpeed,
@@ -98,6 +105,9 @@ impl Observable {
             Observable::Polarization => "polarization".into(),
             Observable::Nematic => "nematic".into(),
             Observable::MinGap => "min_gap".into(),
+            Observable::WallGap => "wall_gap".into(),
+            Observable::Height(i) => format!("height[{i}]"),
+            Observable::WallAngle(i) => format!("wall_angle[{i}]"),
             Observable::MeanSpeed => "mean_speed".into(),
             Observable::Msd => "msd".into(),
             Observable::Peclet(i, j) => format!("Pe[{i},{j}]"),
@@ -115,7 +125,10 @@ impl Observable {
             | Observable::PairMean(..)
             | Observable::PairSeparation(..)
             | Observable::DistanceH(..)
-            | Observable::MinGap => "m",
+            | Observable::MinGap
+            | Observable::WallGap
+            | Observable::Height(_) => "m",
+            Observable::WallAngle(_) => "rad",
             Observable::Tension(_) => "N",
             Observable::MeanSpeed => "m/s",
             Observable::Msd => "m^2",
@@ -161,7 +174,9 @@ impl Observable {
             | Observable::CenterG(i)
             | Observable::Dir(i)
             | Observable::Length(i)
-            | Observable::Tension(i) => vec![i],
+            | Observable::Tension(i)
+            | Observable::Height(i)
+            | Observable::WallAngle(i) => vec![i],
             Observable::PairMean(i, j, _)
             | Observable::PairSeparation(i, j, _)
             | Observable::Q(i, j)
@@ -173,6 +188,7 @@ impl Observable {
             | Observable::Msd
             | Observable::Nematic
             | Observable::MinGap
+            | Observable::WallGap
             | Observable::MeanSpeed
             | Observable::PairDistances { .. }
             | Observable::Field { .. } => vec![],
@@ -193,6 +209,16 @@ impl Observable {
         }
         for i in self.indices() {
             scene.swimmer(i)?;
+        }
+        if matches!(
+            self,
+            Observable::WallGap | Observable::Height(_) | Observable::WallAngle(_)
+        ) && scene.wall().is_none()
+        {
+            return Err(super::error::invalid!(
+                "{} is measured from the wall, and this scene has none; give the scene a wall first (a plane at height z, m)",
+                self.name()
+            ));
         }
         Ok(())
     }
@@ -263,6 +289,9 @@ impl Observable {
                 vec![SymmetricEigen::new(q).eigenvalues.max()]
             }
             Observable::MinGap => vec![Self::min_gap(s)],
+            Observable::WallGap => vec![Self::wall_gap(s)],
+            Observable::Height(i) => vec![s.center(i)?.z - Self::wall_z(s)],
+            Observable::WallAngle(i) => vec![s.dir(i)?.z.clamp(-1.0, 1.0).asin()],
             Observable::MeanSpeed => {
                 let v = probe.center_velocities(s)?;
                 vec![v.iter().map(|v| v.norm()).sum::<f64>() / v.len().max(1) as f64]
@@ -336,6 +365,25 @@ impl Observable {
         } else {
             (0..c.len()).map(row).fold(vec![0.0; bins], add)
         })
+    }
+
+    /// The wall's height (checked to exist by [`Observable::check`]).
+    fn wall_z(s: &Scene) -> f64 {
+        s.wall().map_or(0.0, |w| w.z)
+    }
+
+    /// The smallest gap between a sphere and the wall (m); +inf without spheres.
+    fn wall_gap(s: &Scene) -> f64 {
+        let Some(w) = s.wall() else {
+            return f64::INFINITY;
+        };
+        (0..s.count())
+            .flat_map(|i| {
+                let (x1, x2) = s.spheres(i);
+                let d = s.swimmers()[i];
+                [w.gap(&x1, d.a1), w.gap(&x2, d.a2)]
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// The smallest sphere gap of the scene (m); +inf with fewer than two spheres.

@@ -36,13 +36,15 @@ pub fn plan(s: &Scene) -> Result<Plan> {
         Backend::Cpu => cpu("the cpu backend was chosen".into()),
         Backend::Gpu => {
             fit.map_err(|e| {
+                let method = super::gpu::support::only_the_integrator_refused(s);
+                let fixes = [
+                    Setting::Backend("cpu"),
+                    Setting::Backend("auto"),
+                    Setting::FixedStep,
+                ];
                 unsupported(
                     format!("the gpu backend: {e}"),
-                    &[
-                        Setting::Backend("cpu"),
-                        Setting::Backend("auto"),
-                        Setting::FixedStep,
-                    ],
+                    &fixes[..if method { 3 } else { 2 }],
                 )
             })?;
             let dev = super::gpu::device().map_err(|e| {

@@ -4,8 +4,10 @@
 //! State per swimmer as in the averaged model: ΔR_H and unit N (the length is known). With
 //! tension T_τ on dumbbell τ (force +T N on sphere 1, −T N on sphere 2), the velocity of every
 //! sphere is linear in the tensions, and the constraint d(|X₂ − X₁|)/dt = L̇ for every dumbbell is an
-//! S×S linear system A T = L̇ with
-//! A_στ = N_σ · [(H_{2σ,1τ} − H_{1σ,1τ}) − (H_{2σ,2τ} − H_{1σ,2τ})] N_τ.
+//! S×S linear system A T = L̇ − N·(v^b₂ − v^b₁) with
+//! A_στ = N_σ · [(H_{2σ,1τ} − H_{1σ,1τ}) − (H_{2σ,2τ} − H_{1σ,2τ})] N_τ,
+//! where v^b = M F^b are the sphere velocities of the body forces (a wall's repulsion, external
+//! forces; zero without them).
 //! Then, as in the spring model, dR_H/dt = (a1 u₁ + a2 u₂)/(a1+a2) (the drag parts cancel exactly)
 //! and dN/dt = (I − NNᵀ)(u₂ − u₁)/L, u the interaction velocities. Nothing is stiff any more: the
 //! step is set by the stroke, not by the spring.
@@ -26,6 +28,8 @@ pub struct RigidSystem {
     spheres: Spheres,
     a: DMatrix<f64>,
     rate: DVector<f64>,
+    /// Scratch: the sphere velocities of the body forces alone.
+    body: Vec<Vector3<f64>>,
 }
 
 impl RigidSystem {
@@ -51,6 +55,7 @@ impl RigidSystem {
             spheres: Spheres::new(swimmers, mu, mobility, contacts),
             a: DMatrix::zeros(s, s),
             rate: DVector::zeros(s),
+            body: Vec::new(),
         }
     }
 
@@ -67,6 +72,11 @@ impl RigidSystem {
     /// H_αβ v for spheres α, β (self term when α = β).
     fn h(&self, alpha: usize, beta: usize, v: &Vector3<f64>) -> Vector3<f64> {
         self.spheres.block_apply(alpha, beta, v)
+    }
+
+    /// The constant external force on every sphere (N; none when empty).
+    pub fn set_external(&mut self, external: Vec<Vector3<f64>>) {
+        self.spheres.set_external(external);
     }
 
     /// Take `operator` as the boundary's mobility (open space until set).
@@ -97,6 +107,13 @@ impl RigidSystem {
             }
             let d = &self.swimmers[sg];
             self.rate[sg] = d.lambda * d.omega * (d.omega * t + d.phase).cos();
+        }
+        // Body forces (a wall's repulsion, external forces) move the spheres too: the tensions
+        // make up what their velocities leave of L̇.
+        if self.spheres.body_velocities(&mut self.body) {
+            for (sg, ns) in n.iter().enumerate() {
+                self.rate[sg] -= ns.dot(&(self.body[2 * sg + 1] - self.body[2 * sg]));
+            }
         }
         if !solve_in_place(&mut self.a, &mut self.rate) {
             self.rate.fill(f64::NAN);

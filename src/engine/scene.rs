@@ -14,6 +14,7 @@ use super::error::{
     invalid, require_finite, require_positive, unsupported, EngineError, Result, Setting,
 };
 use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_FROM_SPHERES};
+use super::forces::{ExternalForces, Gravity};
 use super::integrators::{IntegratorSpec, OdeSystem, Stats};
 use super::micro::MicroSystem;
 use super::mobility::{Mobility, MobilityOperator};
@@ -23,6 +24,7 @@ use super::periodic::{separation, PeriodicBox};
 use super::rigid::RigidSystem;
 use super::swimmer::{unit_direction, Dumbbell};
 use super::thermal::{NoiseRoot, Thermal};
+use super::wall::{Wall, WallMobility};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -85,6 +87,12 @@ pub struct Scene {
     /// How the box's mobility products are summed (saved only when not "auto").
     #[serde(default, skip_serializing_if = "is_auto_ewald")]
     ewald_method: EwaldMethod,
+    /// A no-slip wall below the fluid; `None`: none (saved only when set).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    wall: Option<Wall>,
+    /// External forces on the spheres (saved only when there are some).
+    #[serde(default, skip_serializing_if = "ExternalForces::is_none")]
+    external: ExternalForces,
 }
 
 fn is_auto_ewald(m: &EwaldMethod) -> bool {
@@ -119,6 +127,8 @@ impl Default for Scene {
             periodic: None,
             ewald_tol: DEFAULT_EWALD_TOL,
             ewald_method: EwaldMethod::Auto,
+            wall: None,
+            external: ExternalForces::default(),
         }
     }
 }
@@ -292,6 +302,12 @@ impl Scene {
             self.periodic = None;
             return Ok(());
         };
+        if self.wall.is_some() {
+            return Err(unsupported(
+                "a periodic box together with a wall is not available (the wall's mobility has no periodic images); remove the wall first",
+                &[Setting::NoWall],
+            ));
+        }
         let b = PeriodicBox::new(sides)?;
         for (i, d) in self.swimmers.iter().enumerate() {
             check_fits_box(d, &b).map_err(|e| invalid!("swimmer {i}: {e}"))?;
@@ -310,6 +326,73 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// The no-slip wall, if any.
+    pub fn wall(&self) -> Option<&Wall> {
+        self.wall.as_ref()
+    }
+
+    /// Put a no-slip wall below the fluid, or (`None`) take it away. Every sphere must lie clear
+    /// above it, and a periodic box is refused (no images of the wall); otherwise the scene is
+    /// unchanged and the error says which.
+    pub fn set_wall(&mut self, wall: Option<Wall>) -> Result<()> {
+        let Some(w) = wall else {
+            self.wall = None;
+            return Ok(());
+        };
+        let w = w.checked()?;
+        if self.periodic.is_some() {
+            return Err(unsupported(
+                "a wall in a periodic box is not available (the wall's mobility has no periodic images); leave the box first",
+                &[Setting::NoBox],
+            ));
+        }
+        self.check_above(&w)?;
+        self.wall = Some(w);
+        Ok(())
+    }
+
+    /// Every sphere clear above wall `w`, or the error naming the first that is not.
+    pub(in crate::engine) fn check_above(&self, w: &Wall) -> Result<()> {
+        for i in 0..self.count() {
+            let (x1, x2) = self.spheres(i);
+            let d = &self.swimmers[i];
+            for (k, (x, a)) in [(x1, d.a1), (x2, d.a2)].into_iter().enumerate() {
+                let gap = w.gap(&x, a);
+                if gap <= 0.0 {
+                    return Err(invalid!(
+                        "sphere {} of swimmer {i} is not above the wall at z = {:e} m (its gap is {gap:.3e} m); move the swimmers up or put the wall lower",
+                        k + 1,
+                        w.z
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The external forces on the spheres.
+    pub fn external(&self) -> ExternalForces {
+        self.external
+    }
+
+    /// Put the same force `force` (N) on every sphere ([0, 0, 0]: none).
+    pub fn set_external_force(&mut self, force: [f64; 3]) -> Result<()> {
+        self.external.force = ExternalForces::check_force(force)?;
+        Ok(())
+    }
+
+    /// Gravity with buoyancy on the spheres, or (`None`) none.
+    pub fn set_gravity(&mut self, gravity: Option<Gravity>) -> Result<()> {
+        self.external.gravity = gravity.map(Gravity::checked).transpose()?;
+        Ok(())
+    }
+
+    /// The external force on every sphere in sphere order (empty when there is none).
+    pub(crate) fn sphere_forces(&self) -> Vec<Vector3<f64>> {
+        self.external
+            .per_sphere(self.swimmers.iter().flat_map(|d| [d.a1, d.a2]))
     }
 
     /// Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility.
@@ -370,14 +453,15 @@ impl Scene {
     }
 
     /// The boundary's mobility for the sphere models: the box's Ewald sums with products by
-    /// `method` (blocks and matrices are Beenakker's either way), or open space.
+    /// `method` (blocks and matrices are Beenakker's either way), the wall's, or open space.
     pub(crate) fn mobility_operator_by(
         &self,
         method: EwaldMethod,
     ) -> Result<Box<dyn MobilityOperator>> {
-        Ok(match self.ewald_by(method)? {
-            Some(e) => Box::new(e),
-            None => Box::new(OpenSpace::new(self.mu, self.mobility)),
+        Ok(match (self.ewald_by(method)?, self.wall) {
+            (Some(e), _) => Box::new(e),
+            (None, Some(w)) => Box::new(WallMobility::new(self.mu, self.mobility, w)),
+            (None, None) => Box::new(OpenSpace::new(self.mu, self.mobility)),
         })
     }
 

@@ -25,8 +25,15 @@ pub(crate) struct Spheres {
     forces: Vec<Vector3<f64>>,
     /// The dumbbell force f(σ) on sphere 1 of each dumbbell.
     spring: Vec<Vector3<f64>>,
-    /// Steric force on every sphere (empty when the repulsion is off).
-    steric: Vec<Vector3<f64>>,
+    /// The forces on every sphere that no dumbbell balances: steric repulsion between swimmers,
+    /// the boundary's repulsion and the external forces (empty when there are none).
+    body: Vec<Vector3<f64>>,
+    /// The constant external force on every sphere (N; empty when none).
+    external: Vec<Vector3<f64>>,
+    /// Whether the boundary repels spheres (a wall).
+    boundary_forces: bool,
+    /// Scratch of the mobility's divergence.
+    div: Vec<Vector3<f64>>,
     contacts: Contacts,
     u: Vec<Vector3<f64>>,
     /// Scratch of the gap passes (large scenes).
@@ -52,10 +59,10 @@ impl Spheres {
             pos: vec![Vector3::zeros(); n],
             forces: vec![Vector3::zeros(); n],
             spring: vec![Vector3::zeros(); swimmers.len()],
-            steric: match contacts.steric {
-                Some(_) => vec![Vector3::zeros(); n],
-                None => Vec::new(),
-            },
+            body: Vec::new(),
+            external: Vec::new(),
+            boundary_forces: false,
+            div: Vec::new(),
             contacts,
             u: vec![Vector3::zeros(); n],
             soa: SoaSpheres::default(),
@@ -66,7 +73,78 @@ impl Spheres {
     /// Take `operator` as the boundary's mobility (open space until set).
     pub(crate) fn set_mobility(&mut self, operator: Box<dyn MobilityOperator>) {
         self.soa.periodic = operator.periodic().copied();
+        self.boundary_forces = operator.solid();
         self.operator = operator;
+    }
+
+    /// Put the constant force `external[α]` (N) on every sphere α (none when empty).
+    pub(crate) fn set_external(&mut self, external: Vec<Vector3<f64>>) {
+        self.external = external;
+    }
+
+    /// Whether some sphere carries a force that no dumbbell balances.
+    fn has_body_forces(&self) -> bool {
+        self.contacts.steric.is_some() || self.boundary_forces || !self.external.is_empty()
+    }
+
+    /// The forces of [`Spheres::body`] at the current positions.
+    fn body_forces(&mut self) {
+        let n = self.pos.len();
+        self.body.clear();
+        if !self.has_body_forces() {
+            return;
+        }
+        match self.external.is_empty() {
+            true => self.body.resize(n, Vector3::zeros()),
+            false => self.body.extend_from_slice(&self.external),
+        }
+        if let Some(st) = self.contacts.steric {
+            st.add_forces(
+                &self.pos,
+                &self.radii,
+                self.operator.periodic(),
+                &mut self.body,
+                n >= PARALLEL_SPHERES,
+            );
+        }
+        self.operator
+            .add_boundary_forces(&self.pos, &self.radii, &mut self.body);
+    }
+
+    /// The velocities the body forces alone give every sphere, M F^b, self drag included, into
+    /// `out`; `false` (nothing written) when there are none. The rigid-stroke model's
+    /// constraints take them out of the tensions' right-hand side.
+    pub(crate) fn body_velocities(&mut self, out: &mut Vec<Vector3<f64>>) -> bool {
+        self.body_forces();
+        if self.body.is_empty() {
+            return false;
+        }
+        std::mem::swap(&mut self.forces, &mut self.body);
+        self.pair_velocities();
+        std::mem::swap(&mut self.forces, &mut self.body);
+        out.clear();
+        out.extend(
+            self.u
+                .iter()
+                .zip(&self.body)
+                .zip(&self.radii)
+                .map(|((u, f), a)| u + f * self_mobility(self.mu, *a)),
+        );
+        true
+    }
+
+    /// Add the Itô drift kT ∇·M to the velocities of the last [`Spheres::interact`], where the
+    /// boundary's mobility varies with the positions (near a wall).
+    pub(crate) fn add_thermal_drift(&mut self, kt: f64) {
+        self.div.resize(self.pos.len(), Vector3::zeros());
+        if self
+            .operator
+            .divergence(&self.pos, &self.radii, &mut self.div)
+        {
+            for (u, d) in self.u.iter_mut().zip(&self.div) {
+                *u += d * kt;
+            }
+        }
     }
 
     /// The periodic box, if any.
@@ -89,8 +167,9 @@ impl Spheres {
     /// Put force `f(σ)` on sphere 1 and −f(σ) on sphere 2 of every dumbbell (each dumbbell is
     /// force-free) and compute the interaction velocities u_α = Σ_{β≠α} H_αβ F_β.
     ///
-    /// With steric repulsion on, its forces F^s join the others and u_α also carries their own
-    /// drag F^s_α/(6πμa_α) (they are not force-free per dumbbell, so that part does not cancel).
+    /// The body forces F^b (steric repulsion, the boundary's repulsion, external forces) join
+    /// the others and u_α also carries their own drag F^b_α/(6πμa_α) (they are not force-free
+    /// per dumbbell, so that part does not cancel).
     #[inline]
     pub(crate) fn interact(&mut self, f: impl Fn(usize) -> Vector3<f64>) {
         for s in 0..self.radii.len() / 2 {
@@ -99,23 +178,13 @@ impl Spheres {
             self.forces[2 * s] = fs;
             self.forces[2 * s + 1] = -fs;
         }
-        let n = self.pos.len();
-        if let Some(st) = self.contacts.steric {
-            self.steric.fill(Vector3::zeros());
-            st.add_forces(
-                &self.pos,
-                &self.radii,
-                self.operator.periodic(),
-                &mut self.steric,
-                n >= PARALLEL_SPHERES,
-            );
-            for (f, s) in self.forces.iter_mut().zip(&self.steric) {
-                *f += s;
-            }
+        self.body_forces();
+        for (f, b) in self.forces.iter_mut().zip(&self.body) {
+            *f += b;
         }
         self.pair_velocities();
-        for ((u, s), a) in self.u.iter_mut().zip(&self.steric).zip(&self.radii) {
-            *u += s * self_mobility(self.mu, *a);
+        for ((u, b), a) in self.u.iter_mut().zip(&self.body).zip(&self.radii) {
+            *u += b * self_mobility(self.mu, *a);
         }
     }
 
@@ -160,6 +229,11 @@ impl Spheres {
     /// The first pair of overlapping spheres at the current positions, as a problem naming the
     /// swimmers; with overlaps between swimmers allowed, only a dumbbell's own spheres count.
     pub(crate) fn first_overlap(&mut self) -> Option<Problem> {
+        if let Some((a, gap)) = self.operator.boundary_gap(&self.pos, &self.radii) {
+            if gap <= 0.0 {
+                return Some(wall_problem(gap, a));
+            }
+        }
         if self.contacts.allow_overlap {
             return (0..self.pos.len() / 2).find_map(|s| {
                 let gap = (self.pos[2 * s] - self.pos[2 * s + 1]).norm()
@@ -185,6 +259,20 @@ impl Spheres {
             }
         }
         None
+    }
+}
+
+/// The guard's report of sphere `a` reaching into the wall by −`gap`.
+fn wall_problem(gap: f64, a: usize) -> Problem {
+    let s = a / 2;
+    Problem {
+        swimmer: Some(s),
+        cause: format!(
+            "sphere {} of swimmer {s} touched the wall (gap {gap:.3e} m)",
+            a % 2 + 1
+        ),
+        hint: "stiffen the wall's repulsion or widen its range (the wall's stiffness and range), take a smaller time step, or start the swimmers further from the wall".into(),
+        fixes: Vec::new(),
     }
 }
 

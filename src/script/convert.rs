@@ -51,6 +51,8 @@ pub fn setting_in_script(s: &Setting) -> String {
         Setting::NoiseIntegrator => "s.integrator = euler(dt) or platen(dt)".into(),
         Setting::EwaldMethod(m) => format!("s.ewald_method = \"{m}\""),
         Setting::LooserEwaldTol => "a looser s.ewald_tol (e.g. 1e-6)".into(),
+        Setting::NoWall => "s.wall = ()".into(),
+        Setting::NoBox => "s.box = ()".into(),
     }
 }
 

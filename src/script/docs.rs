@@ -30,6 +30,7 @@ pub static DOCS: LazyLock<Vec<Doc>> = LazyLock::new(|| {
         super::scene_api::DOCS,
         super::dumbbell_api::DOCS,
         super::scene_settings_api::DOCS,
+        super::wall_api::DOCS,
         super::sweep_api::DOCS,
         super::plot_api::DOCS,
         super::picture_api::DOCS,

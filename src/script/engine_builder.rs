@@ -3,7 +3,7 @@
 use super::{
     csv_api, dumbbell_api, field_api, float_cmp, integrator_api, interrupt, limits, observable_api,
     panic_guard::guard, params, picture_api, plot_api, render_error, scene_api, scene_settings_api,
-    stdlib, sweep_api, types, util_api, wrong_calls,
+    stdlib, sweep_api, types, util_api, wall_api, wrong_calls,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -37,6 +37,7 @@ pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModu
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);
     scene_settings_api::register(&mut engine);
+    wall_api::register(&mut engine);
     observable_api::register(&mut engine);
     float_cmp::register(&mut engine);
     csv_api::register(&mut engine);

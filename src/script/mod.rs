@@ -29,6 +29,7 @@ pub mod stdlib;
 mod sweep_api;
 mod types;
 mod util_api;
+mod wall_api;
 mod wrong_calls;
 
 pub use convert::{engine_message, script_error, setting_in_script, ScriptResult};

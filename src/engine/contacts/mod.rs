@@ -98,13 +98,13 @@ pub enum StericLaw {
 }
 
 impl StericLaw {
-    fn is_harmonic(&self) -> bool {
+    pub(crate) fn is_harmonic(&self) -> bool {
         *self == StericLaw::Harmonic
     }
 
     /// The force over the stiffness at overlap `x` of range `range` (m).
     #[inline]
-    fn force(self, x: f64, range: f64) -> f64 {
+    pub(crate) fn force(self, x: f64, range: f64) -> f64 {
         match self {
             StericLaw::Harmonic => x,
             // Past contact (x > δ, overlapping bodies) the parabola's tangent carries on.

@@ -24,6 +24,12 @@ pub fn supports(s: &Scene) -> Result<(), String> {
     tableau(&s.integrator()).map(|_| ())
 }
 
+/// Whether the integrator alone keeps `s` off the device (its model and options could run
+/// there), so that another integrator is a fix.
+pub fn only_the_integrator_refused(s: &Scene) -> bool {
+    model(s.model()).is_ok() && options(s).is_ok() && tableau(&s.integrator()).is_err()
+}
+
 /// The models with device kernels.
 fn model(model: Model) -> Result<(), String> {
     match model {
@@ -35,12 +41,14 @@ fn model(model: Model) -> Result<(), String> {
     }
 }
 
-/// The options the device kernels do not have: a periodic box, contact handling, the cutoff,
-/// thermal noise.
+/// The options the device kernels do not have: a periodic box, a wall, external forces, contact
+/// handling, the cutoff, thermal noise.
 fn options(s: &Scene) -> Result<(), String> {
     let cpu_only = |what: &str| Err(format!("{what} runs on the CPU only"));
     match s.model() {
         _ if s.periodic().is_some() => cpu_only("a periodic box (Ewald sums, minimum images)"),
+        _ if s.wall().is_some() => cpu_only("a wall (the Rotne-Prager-Blake mobility)"),
+        _ if !s.external().is_none() => cpu_only("external forces and gravity"),
         _ if s.thermal().is_on() => cpu_only("thermal noise (temperature above 0)"),
         _ if s.contacts() != Contacts::default() => {
             cpu_only("contact handling (overlaps allowed, steric repulsion)")

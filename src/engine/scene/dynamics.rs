@@ -75,6 +75,7 @@ impl Scene {
                 );
                 sys.set_thermal(self.thermal);
                 sys.set_mobility(self.mobility_operator()?);
+                sys.set_external(self.sphere_forces());
                 Box::new(sys)
             }
             Model::Rigid => {
@@ -88,6 +89,7 @@ impl Scene {
             }
             Model::Averaged => {
                 self.check_averaged()?;
+                self.check_averaged_open()?;
                 let mut sys =
                     AveragedSystem::new(&self.swimmers, &self.base, self.coefficients, &self.state);
                 sys.set_cutoff(self.averaged_cutoff()?);
@@ -111,6 +113,7 @@ impl Scene {
         );
         // The constraint solve takes blocks, which are Beenakker's sums.
         sys.set_mobility(self.mobility_operator_by(EwaldMethod::Beenakker)?);
+        sys.set_external(self.sphere_forces());
         Ok(sys)
     }
 
@@ -128,6 +131,24 @@ impl Scene {
                 "the averaged model's cutoff {c:e} m is longer than half the box's shortest side ({half:e} m): a pair would meet two images; set the cutoff to {half:e} m or less, or use a larger box"
             )),
         }
+    }
+
+    /// The averaged equations are those of swimmers in open space or a box, free of external
+    /// forces: a wall or external forces are refused with the reason.
+    pub(crate) fn check_averaged_open(&self) -> Result<()> {
+        if self.wall.is_some() {
+            return Err(unsupported(
+                "the averaged model has no wall equations (its pair terms are open space's); long runs near a wall come from auto or stroboscopic averaging on the microscopic model",
+                &[Setting::Model("micro"), Setting::Model("rigid"), Setting::NoWall],
+            ));
+        }
+        if !self.external.is_none() {
+            return Err(unsupported(
+                "the averaged model has no external forces (its swimmers are force-free); the microscopic and rigid-stroke models take them",
+                &[Setting::Model("micro"), Setting::Model("rigid")],
+            ));
+        }
+        Ok(())
     }
 
     /// The averaged equations describe identical strokes: ω, λ and ℓ must agree.

@@ -91,6 +91,19 @@ impl Scene {
                 super::check_fits_box(d, &b).map_err(|e| invalid!("swimmer {i}: {e}"))?;
             }
         }
+        if let Some(w) = self.wall {
+            let w = w.checked()?;
+            if self.periodic.is_some() {
+                return Err(invalid!(
+                    "the scene file has both a wall and a periodic box, which cannot go together; remove one"
+                ));
+            }
+            self.check_above(&w)?;
+        }
+        crate::engine::forces::ExternalForces::check_force(self.external.force)?;
+        if let Some(g) = self.external.gravity {
+            g.checked()?;
+        }
         if let Some(c) = self.cutoff {
             let mut probe = Scene::new();
             probe.set_cutoff(Some(c))?;
