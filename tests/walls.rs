@@ -187,27 +187,28 @@ fn symmetric_positive_definite_near_the_wall_with_overlaps() {
 }
 
 /// The operator's product, blocks and matrix are one mobility, damped spheres included:
-/// M F = D F + W F to round-off of the largest velocity.
+/// M F = D F + W F to round-off of the largest velocity, for a set that takes the serial pair
+/// loop and one that takes the parallel one (from 64 spheres on).
 #[test]
 fn product_blocks_and_matrix_agree() {
     let mut rng = Rng(0x1234_5678_9abc_def1);
-    for lift in [1.05, 0.4] {
-        let (pos, radii) = near_wall_spheres(&mut rng, 12, lift);
+    for (n, lift) in [(12, 1.05), (12, 0.4), (80, 0.4)] {
+        let (pos, radii) = near_wall_spheres(&mut rng, n, lift);
         let mut op = WallMobility::new(MU, Mobility::Rpy, Wall::at(-2e-6).unwrap());
-        let forces: Vec<Vector3<f64>> = (0..12)
+        let forces: Vec<Vector3<f64>> = (0..n)
             .map(|_| Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 1e-12)
             .collect();
-        let mut u = vec![Vector3::zeros(); 12];
+        let mut u = vec![Vector3::zeros(); n];
         op.interaction_velocities(&pos, &radii, &forces, &mut u);
         let m = op.matrix(&pos, &radii);
-        let f = DVector::from_iterator(36, forces.iter().flat_map(|f| f.iter().copied()));
+        let f = DVector::from_iterator(3 * n, forces.iter().flat_map(|f| f.iter().copied()));
         let mf = &m * &f;
-        for k in 0..12 {
+        for k in 0..n {
             let v = u[k] + forces[k] * self_mobility(MU, radii[k]);
             for c in 0..3 {
                 assert!(
                     (v[c] - mf[3 * k + c]).abs() <= 1e-13 * mf.amax(),
-                    "lift {lift}"
+                    "{n} spheres, lift {lift}"
                 );
             }
         }
