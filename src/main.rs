@@ -90,7 +90,7 @@ enum Command {
         action: Option<KernelAction>,
     },
     /// Render every figure of the paper (scripts/paper, built in): CSV and PNG to out/paper/,
-    /// and the PNGs also to --out if given (e.g. docs/figures for the README).
+    /// and the PNGs also to --out if given (e.g. docs/src/figures for the book).
     MakeFigures {
         /// The scripts' quick variants (fewer points and periods).
         #[arg(long)]
@@ -99,6 +99,9 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
+    /// Print the reference of every script name and shell command as Markdown: the book's
+    /// reference chapter (swimlab reference > docs/src/reference.md), from what :help shows.
+    Reference,
 }
 
 #[derive(Subcommand)]
@@ -171,6 +174,10 @@ fn main() -> ExitCode {
         })
     } else {
         match cli.command {
+            Some(Command::Reference) => {
+                print!("{}", swimlab::repl::reference::markdown());
+                Ok(())
+            }
             Some(Command::Bench { which, quick }) => {
                 swimlab::bench::report::run(which.into(), quick)
             }

@@ -3,6 +3,7 @@
 
 mod helper;
 pub mod kernel;
+pub mod reference;
 mod session;
 pub mod terminal;
 

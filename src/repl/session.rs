@@ -58,7 +58,8 @@ impl Default for Session {
     }
 }
 
-const COMMANDS: &[(&str, &str)] = &[
+/// The shell's `:commands` and what each does (`:help` lists them; so does the book's reference).
+pub(super) const COMMANDS: &[(&str, &str)] = &[
     (
         ":help",
         "list everything; :help NAME shows one name with an example",

@@ -1,5 +1,5 @@
 //! `swimlab make-figures`: the paper's figure scripts, built into the binary, run in turn; their
-//! pictures copied to a folder (e.g. docs/figures for the README).
+//! pictures copied to a folder (e.g. docs/src/figures for the book).
 
 use super::engine_builder::run_source_with;
 use super::params::RunOptions;

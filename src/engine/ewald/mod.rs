@@ -49,7 +49,7 @@ pub enum EwaldMethod {
 
 /// From this many spheres "auto" takes the spectral method: the crossover measured by
 /// `swimlab bench ewald`: Beenakker 1.25x faster at 512 spheres, spectral 1.4x faster at 1,000
-/// (README, "Periodic boxes").
+/// (the book, "Suspensions, boxes and fields").
 pub const SPECTRAL_FROM_SPHERES: usize = 700;
 
 impl Named for EwaldMethod {

@@ -6,7 +6,7 @@ use super::*;
 /// The microscopic model's default RK4 step times the stiffest spring's relaxation rate. RK4 is
 /// stable up to 2.785; at 0.8 the stroke-induced wobble of an isolated asymmetric dumbbell's R_H
 /// closes to < 1e-12 ℓ per period (measured 7e-13; at 2.0 it is 6e-11, which would be 5e-5 of the
-/// Fig-1 drift). The error falls as dt⁵ (README, "Accuracy").
+/// Fig-1 drift). The error falls as dt⁵ (the book, "Integrators and accuracy").
 pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
 /// With thermal noise the spring model's default Euler-Maruyama step times the stiffest spring's
 /// relaxation rate: Euler-Maruyama overestimates a spring's length variance kT/k0 by 1/(1 − 0.05).
@@ -14,14 +14,14 @@ pub const DEFAULT_NOISY_STEP_TIMES_RATE: f64 = 0.1;
 /// The default step never exceeds this fraction of the shortest period, so that soft springs
 /// (small k0) still resolve the stroke.
 pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
-/// Default tolerance of the rigid-stroke model's adaptive integrator (README, "work-precision").
+/// Default tolerance of the rigid-stroke model's adaptive integrator (the book, "Integrators and accuracy").
 pub const DEFAULT_RIGID_RTOL: f64 = 1e-7;
 /// The tolerance of `auto(tol)`, the default of the spring and rigid-stroke models without noise,
 /// relative to the drift: ten times [`dynamics::RK4_DEFAULT_DRIFT_ERROR`], so that auto's inner RK4,
 /// which steps where its drift error is a tenth of tol, steps at exactly the direct step
 /// 0.8/rate. Runs that cannot be averaged are then the direct RK4 runs bit for bit; a larger
 /// inner step errs on the drift of pairs far apart (a swimmer's own stroke error does not shrink
-/// with the interaction; README, "Long runs").
+/// with the interaction; the book, "Long runs").
 pub const DEFAULT_AUTO_TOL: f64 = 1.1e-5;
 /// The largest denominator q of a ratio ωᵢ/ω₀ = p/q that [`Scene::common_period`] recognises.
 pub const MAX_PERIOD_DENOMINATOR: u64 = 64;
@@ -45,7 +45,7 @@ pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
 
 /// Default tolerance of `suspension(tol)`, the averaged model's default for a suspension: the
 /// loosest decade whose displacements stay well within 1e-3 (RMS, relative) of fine RK4 on a
-/// suspension with steric contacts (README, "Bulk suspensions at speed").
+/// suspension with steric contacts (the book, "Suspensions, boxes and fields").
 pub const DEFAULT_SUSPENSION_TOL: f64 = 1e-3;
 
 /// From this many swimmers an averaged scene counts as a suspension (whatever its settings).

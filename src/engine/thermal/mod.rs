@@ -26,7 +26,7 @@ pub const BOLTZMANN: f64 = 1.380_649e-23;
 pub const DEFAULT_LANCZOS_TOL: f64 = 1e-6;
 
 /// Up to this many spheres "auto" takes the dense Cholesky factor, above it Lanczos (measured by
-/// `examples/noise_roots.rs`, README "Thermal noise").
+/// `examples/noise_roots.rs`, the book, "Thermal noise").
 pub const CHOLESKY_MAX_SPHERES: usize = 48;
 
 /// The highest temperature accepted (K): far above any liquid, low enough that the noise never

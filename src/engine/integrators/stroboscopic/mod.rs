@@ -23,7 +23,7 @@
 //! - **Macro steps.** Dormand-Prince 5(4) (first-same-as-last: six new slopes a step) in whole
 //!   periods, H = mT, so every macro state is a stroboscopic state of the same phase; every
 //!   stage's Ψ starts at the step's own time. Fifth order rather than Bogacki-Shampine's third:
-//!   on the 64-swimmer suspension of README's "Long runs" the steps grow from ~30 to ~160 periods
+//!   on the 64-swimmer suspension of the book's "Long runs" the steps grow from ~30 to ~160 periods
 //!   at tol 1e-3, and a step's samples (6d periods) buy five times as many periods. The error
 //!   estimate is measured against the change the step makes (each 3-vector
 //!   against the largest change of its kind among all swimmers: positions, or orientations, whose
