@@ -7,10 +7,11 @@ use super::pairs::{self, SoaSpheres};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// From this many spheres on, the vectorised row kernel ([`pairs`]) replaces the symmetric
-/// half-loop (below it the half-loop's halved arithmetic wins; measured in `benches/kernels.rs`).
+/// half-loop (below this size the half-loop's halved arithmetic wins; the measurement is in the
+/// book's design notes).
 pub const FAST_KERNEL_SPHERES: usize = 64;
-/// From this many spheres on, the rows run in parallel (a product costs ≳ 0.3 ms, far above
-/// rayon's few-µs dispatch).
+/// From this many spheres on, the rows run in parallel: a product is then long enough that
+/// rayon's dispatch is a negligible share of it (timings in the book's design notes).
 pub const PARALLEL_SPHERES: usize = 256;
 
 /// The mobility of spheres in an unbounded fluid of viscosity `mu`.

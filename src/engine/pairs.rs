@@ -12,8 +12,8 @@
 //!   pairs touch disjoint accumulators, so they run in parallel with rayon. A tile pair runs
 //!   without overlap masks unless one of its pairs overlaps (then it is redone with them), and
 //!   in the AVX-512 build takes 1/r from the 14-bit estimate and one correction
-//!   ([`super::simd::Avx512InvSqrt`]). About 2× the rows' interactions per second (the book,
-//!   "Suspensions and the CPU pair kernel").
+//!   ([`super::simd::Avx512InvSqrt`]). More interactions per second than the rows (the book,
+//!   "Suspensions and the CPU pair kernel"; the factor is in its design notes).
 //! - **By rows** ([`row_velocities`]): each row i sums over all j, every pair evaluated from both
 //!   ends; rows are independent and run in parallel.
 //!

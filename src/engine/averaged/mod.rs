@@ -78,8 +78,9 @@ impl Shortcuts {
     }
 }
 
-/// From this many swimmers on, the rows of the pair sums run in parallel (a row costs ~S × 60 ns,
-/// so 256 rows are ≳ 4 ms of work against rayon's few-µs dispatch).
+/// From this many swimmers on, the rows of the pair sums run in parallel: each row costs O(S),
+/// so the rows together are then long enough that rayon's dispatch is a negligible share of them
+/// (timings in the book's design notes).
 pub const PARALLEL_SWIMMERS: usize = 256;
 
 /// Centres and orientations as structure of arrays, refilled at every right-hand side.

@@ -47,9 +47,9 @@ pub enum EwaldMethod {
     Spectral,
 }
 
-/// From this many spheres "auto" takes the spectral method: the crossover measured by
-/// `swimlab bench ewald`: Beenakker 1.25x faster at 512 spheres, spectral 1.4x faster at 1,000
-/// (the book, "Suspensions, boxes and fields").
+/// From this many spheres "auto" takes the spectral method: within the crossover that
+/// `swimlab bench ewald` measures (the book, "Suspensions, boxes and fields"; the figures are in
+/// its design notes).
 pub const SPECTRAL_FROM_SPHERES: usize = 700;
 
 impl Named for EwaldMethod {

@@ -168,14 +168,14 @@ impl Scene {
 }
 
 /// The relative drift error of the spring model's default RK4 step: the Fig-1 mirror pair over 100
-/// periods from t = 0 against dopri5(1e-11), measured 1.06e-6 (halving the step: 5.7e-8, the
-/// dt⁴ of RK4).
+/// periods from t = 0 against dopri5(1e-11), rounded up from its measurement (the book's design
+/// notes).
 pub const RK4_DEFAULT_DRIFT_ERROR: f64 = 1.1e-6;
 
 /// The largest inner RK4 step of stroboscopic averaging, in units of 1/rate (rate = the stiffest
 /// spring's k0(1/γ1 + 1/γ2)): RK4's stability bound on the negative real axis is 2.785 (PHYSICS.md;
-/// the hydrodynamic interaction slows the spring mode, and `bench stability` measures 3.0-4.5),
-/// so 2.5 keeps a tenth in hand. At tol 1e-3 the accuracy-bound step, 2.47/rate, is below it.
+/// the hydrodynamic interaction slows the spring mode, so the true limit lies higher, as
+/// `bench stability` shows: the book's design notes), so 2.5 keeps a tenth in hand. At tol 1e-3 the accuracy-bound step, 2.47/rate, is below it.
 pub const RK4_STABLE_STEP_RATE: f64 = 2.5;
 
 /// RK4 steps per period above which the springs count as stiff: `auto` and stroboscopic
@@ -247,7 +247,8 @@ impl Scene {
             .ok_or_else(|| invalid!("the inner integrator {inner} must be a direct method"))?;
         // Periods integrated directly after a start, for the springs to settle from L(0).
         let transient = match self.model {
-            // The hydrodynamic interaction slows a spring's mode (bench stability: by < 2×).
+            // Twice the e-foldings at the isolated rate: the hydrodynamic interaction slows a
+            // spring's mode, by less than that factor (bench stability; the book's design notes).
             Model::Micro => {
                 let slowest = self
                     .swimmers

@@ -5,8 +5,9 @@ use super::*;
 
 /// The microscopic model's default RK4 step times the stiffest spring's relaxation rate. RK4 is
 /// stable up to 2.785; at 0.8 the stroke-induced wobble of an isolated asymmetric dumbbell's R_H
-/// closes to < 1e-12 ℓ per period (measured 7e-13; at 2.0 it is 6e-11, which would be 5e-5 of the
-/// Fig-1 drift). The error falls as dt⁵ (the book, "Integrators and accuracy").
+/// closes to far below the Fig-1 drift each period, where a step near the stability bound would
+/// leave a visible share of it (the measurement is in the book's design notes). The error falls
+/// as dt⁵ (the book, "Integrators and accuracy").
 pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
 /// With thermal noise the spring model's default Euler-Maruyama step times the stiffest spring's
 /// relaxation rate: Euler-Maruyama overestimates a spring's length variance kT/k0 by 1/(1 − 0.05).

@@ -16,7 +16,8 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
 
 /// From this many spheres on, the wall's pair terms run on rayon's threads, each summing its
-/// rows into a buffer of its own (a product then costs ≳ 0.1 ms, far above the dispatch).
+/// rows into a buffer of its own (a product is then long enough that the dispatch is a
+/// negligible share of it; timings in the book's design notes).
 const PARALLEL_SPHERES: usize = 64;
 
 /// Spheres in a fluid of viscosity `mu` above the no-slip plane of `wall`.

@@ -9,9 +9,9 @@
 //!   points y, Ψ(y), …, Ψ^d(y): the derivative at s = 0 of the polynomial through them at
 //!   s = 0 … d periods (order d in T). The degree d (2 … [`MAX_DEGREE`]) is chosen at the start
 //!   and at every step's end by comparing slopes of neighbouring degrees from the same points:
-//!   the lowest whose error so estimated takes at most a tenth of the tolerance. A fixed d = 2
-//!   left close pairs with an error floor, the quadratic's truncation (1.4e-5 of the drift at
-//!   2ℓ, 2.2e-7 at 3ℓ, whatever the tolerance). A stage state y + H Σ a_j k_j is extrapolated
+//!   the lowest whose error so estimated takes at most a tenth of the tolerance: a fixed low degree
+//!   would leave close pairs with an error floor, its polynomial's truncation, whatever the
+//!   tolerance (the book's design notes). A stage state y + H Σ a_j k_j is extrapolated
 //!   from the step's start; its fast variables (the springs' lengths,
 //!   [`OdeSystem::fast_variables`]) are extrapolated instead by their rates on the slow
 //!   manifold (the derivative at 0 through their values at Ψ … Ψ^d of each earlier stage), which
@@ -19,12 +19,13 @@
 //!   to relax, and the macro flow is not stiff. Extrapolated with the slope itself, a spring's
 //!   length would carry its own relaxation (a stiff mode under steps of many periods); left
 //!   alone, an extrapolated turn stretches a dumbbell by ~ℓθ²/2 and the next stage fails the
-//!   guards; set to the start state's length, a close pair errs 60× more (tests/stroboscopic.rs).
+//!   guards; set to the start state's length, a close pair errs many times more
+//!   (tests/stroboscopic.rs; the factor is in the book's design notes).
 //! - **Macro steps.** Dormand-Prince 5(4) (first-same-as-last: six new slopes a step) in whole
 //!   periods, H = mT, so every macro state is a stroboscopic state of the same phase; every
 //!   stage's Ψ starts at the step's own time. Fifth order rather than Bogacki-Shampine's third:
-//!   on the 64-swimmer suspension of the book's "Long runs" the steps grow from ~30 to ~160 periods
-//!   at tol 1e-3, and a step's samples (6d periods) buy five times as many periods. The error
+//!   at the same tolerance its steps span several times as many periods, so a step's samples
+//!   (6d periods) buy more of them (the book's design notes). The error
 //!   estimate is measured against the change the step makes (each 3-vector
 //!   against the largest change of its kind among all swimmers: positions, or orientations, whose
 //!   error turns the drift and so counts against the positions' change as well; orientations
@@ -234,7 +235,7 @@ impl Stroboscopic {
 
     /// [`Stroboscopic::slope_at`] that also chooses the degree. The slope of degree d − 1 differs
     /// from that of degree d by about its own error (the series in T/τ, τ the slow time, converges
-    /// fast: measured factors of 50–300 per degree on a pair 2ℓ apart). The degree is the lowest,
+    /// fast: each degree gains a large factor; the book's design notes). The degree is the lowest,
     /// from one below the current one, whose slope's error so estimated stays within a tenth of
     /// the tolerance in the macro error norm (relative to the drift); the slope returned is the
     /// better one of the pair. Up to [`MAX_DEGREE`].
