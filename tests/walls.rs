@@ -628,3 +628,46 @@ fn sedimentation_reaches_the_boltzmann_distribution_only_with_the_divergence_dri
         "without the drift the distribution should be off: {without:e} vs {exact:e}"
     );
 }
+
+/// The wall's parallel pair terms add up in a fixed order: the same velocities, bit for bit, on
+/// one thread and on several (thermal runs' reproducibility rests on it).
+#[test]
+fn the_parallel_wall_product_is_bitwise_independent_of_the_threads() {
+    let mut rng = Rng(0xdead_beef_1234_5678);
+    let n = 150;
+    let (pos, radii) = near_wall_spheres(&mut rng, n, 0.6);
+    let forces: Vec<Vector3<f64>> = (0..n)
+        .map(|_| Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 1e-12)
+        .collect();
+    let product = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut op = WallMobility::new(MU, Mobility::Rpy, Wall::at(-2e-6).unwrap());
+            let mut u = vec![Vector3::zeros(); n];
+            op.interaction_velocities(&pos, &radii, &forces, &mut u);
+            u
+        })
+    };
+    let one = product(1);
+    for threads in [2, 3, 7] {
+        assert!(product(threads) == one, "{threads} threads differ from one");
+    }
+}
+
+/// Random placement above a wall takes only places clear of it, so the scene saves and loads.
+#[test]
+fn random_swimmers_are_placed_above_the_wall() {
+    let src = r#"
+        let s = scene();
+        s.wall = #{ z: 0.0 };
+        s.add_random(dumbbell(), 20, 0.01, 7);
+        if s.count != 20 || s.observe(wall_gap()) <= 0.0 { throw `placed ${s.count}, gap ${s.observe(wall_gap())}`; }
+        s.save("out/tests/walls_random.json");
+        if load_scene("out/tests/walls_random.json").count != 20 { throw "not loaded back"; }
+    "#;
+    swimlab::script::run_source("random above the wall", src, &mut rhai::Scope::new())
+        .unwrap_or_else(|e| panic!("{e}"));
+}

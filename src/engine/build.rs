@@ -168,15 +168,21 @@ pub fn random_suspension_apart(
         };
         let new = Dumbbell { phase, ..d };
         let (x1, x2) = new.sphere_positions(c, dir, scene.contact_length(&new));
-        let clear = [(x1, d.a1), (x2, d.a2)].iter().all(|&(x, a)| {
-            spheres.cells.near(x.x, x.y, x.z, |k, at| {
-                let k = k as usize;
-                let gap = separation(periodic.as_ref(), x - Vector3::from(at)).norm()
-                    - a
-                    - spheres.radii[k];
-                gap > margin
-            })
-        });
+        // Above a wall only places clear of it count (one sphere's stroke closes half the
+        // margin of a pair).
+        let above = scene
+            .check_clear_of_wall(&new, &x1, &x2, 0.5 * margin)
+            .is_ok();
+        let clear = above
+            && [(x1, d.a1), (x2, d.a2)].iter().all(|&(x, a)| {
+                spheres.cells.near(x.x, x.y, x.z, |k, at| {
+                    let k = k as usize;
+                    let gap = separation(periodic.as_ref(), x - Vector3::from(at)).norm()
+                        - a
+                        - spheres.radii[k];
+                    gap > margin
+                })
+            });
         if clear {
             scene.push(new, c, dir);
             spheres.insert(x1, d.a1);

@@ -149,7 +149,7 @@ impl Scene {
                     check_box_within(b, reach)?;
                 }
                 let (x1, x2) = d.sphere_positions(*center, n, self.contact_length(d));
-                self.check_clear_of_wall(d, &x1, &x2)?;
+                self.check_clear_of_wall(d, &x1, &x2, 0.0)?;
                 Ok(n)
             });
             match checked {
@@ -281,7 +281,8 @@ impl Scene {
             check_box_extent(b, self.swimmers.iter().chain([d]))?;
         }
         let (x1, x2) = d.sphere_positions(center, n, self.contact_length(d));
-        self.check_clear_of_wall(d, &x1, &x2)?;
+        // One sphere's stroke closes half of what two spheres' strokes close between them.
+        self.check_clear_of_wall(d, &x1, &x2, 0.5 * margin)?;
         for (s, other) in self.swimmers.iter().enumerate() {
             let (y1, y2) = self.spheres(s);
             for (xa, aa) in [(x1, d.a1), (x2, d.a2)] {
@@ -296,19 +297,20 @@ impl Scene {
         Ok(())
     }
 
-    /// Spheres `x1`, `x2` of swimmer `d` clear above the wall, if there is one.
-    fn check_clear_of_wall(
+    /// Spheres `x1`, `x2` of swimmer `d` more than `margin` above the wall, if there is one.
+    pub(in crate::engine) fn check_clear_of_wall(
         &self,
         d: &Dumbbell,
         x1: &Vector3<f64>,
         x2: &Vector3<f64>,
+        margin: f64,
     ) -> Result<()> {
         let Some(w) = &self.wall else {
             return Ok(());
         };
         for (k, (x, a)) in [(x1, d.a1), (x2, d.a2)].into_iter().enumerate() {
             let gap = w.gap(x, a);
-            if gap <= 0.0 {
+            if gap <= margin {
                 return Err(invalid!(
                     "sphere {} of the swimmer would not be above the wall at z = {:e} m (its gap would be {gap:.3e} m); place it higher",
                     k + 1,

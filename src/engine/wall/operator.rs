@@ -15,10 +15,29 @@ use crate::engine::open_space::OpenSpace;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
 
-/// From this many spheres on, the wall's pair terms run on rayon's threads, each summing its
-/// rows into a buffer of its own (a product is then long enough that the dispatch is a
+/// From this many spheres on, the wall's pair terms run on rayon's threads, each chunk of rows
+/// summing into a buffer of its own (a product is then long enough that the dispatch is a
 /// negligible share of it; timings in the book's design notes).
 const PARALLEL_SPHERES: usize = 64;
+/// The number of row chunks of the parallel pair terms: fixed, so that their sums add up in the
+/// same order on any number of threads; enough to keep a few dozen cores busy.
+const ROW_CHUNKS: usize = 32;
+
+/// The first rows of `chunks` contiguous chunks of the half-loop over `n` rows (row i holds the
+/// n − 1 − i pairs (i, j > i)), each with about the same number of pairs, and `n` at the end.
+fn row_chunks(n: usize, chunks: usize) -> Vec<usize> {
+    let total = n * n.saturating_sub(1) / 2;
+    let mut starts = vec![0];
+    let mut pairs = 0;
+    for i in 0..n {
+        pairs += n - 1 - i;
+        if pairs * chunks >= total * starts.len() && starts.len() < chunks && i + 1 < n {
+            starts.push(i + 1);
+        }
+    }
+    starts.push(n);
+    starts
+}
 
 /// Spheres in a fluid of viscosity `mu` above the no-slip plane of `wall`.
 #[derive(Debug, Clone)]
@@ -166,22 +185,22 @@ impl MobilityOperator for WallMobility {
         self.open
             .interaction_velocities(&self.lifted, radii, &self.damped, out);
         if n >= PARALLEL_SPHERES {
+            // Fixed chunks of rows, each summed into its own buffer, the buffers added in chunk
+            // order: the result does not depend on the threads or how the work was stolen.
+            let starts = row_chunks(n, ROW_CHUNKS);
             let this = &*self;
-            let sum = (0..n)
-                .into_par_iter()
-                .fold(
-                    || vec![Vector3::zeros(); n],
-                    |mut acc, i| {
+            let parts: Vec<Vec<Vector3<f64>>> = starts
+                .par_windows(2)
+                .map(|w| {
+                    let mut acc = vec![Vector3::zeros(); n];
+                    for i in w[0]..w[1] {
                         this.add_wall_row(i, radii, &mut acc);
-                        acc
-                    },
-                )
-                .reduce_with(|mut a, b| {
-                    a.iter_mut().zip(&b).for_each(|(a, b)| *a += b);
-                    a
-                });
-            if let Some(sum) = sum {
-                out.iter_mut().zip(&sum).for_each(|(o, w)| *o += w);
+                    }
+                    acc
+                })
+                .collect();
+            for part in &parts {
+                out.iter_mut().zip(part).for_each(|(o, w)| *o += w);
             }
         } else {
             for i in 0..n {
