@@ -671,3 +671,27 @@ fn random_swimmers_are_placed_above_the_wall() {
     swimlab::script::run_source("random above the wall", src, &mut rhai::Scope::new())
         .unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// Where the phase places the spheres (the rigid-stroke model), a phase that would put a sphere
+/// into the wall is refused, and the scene keeps its phases.
+#[test]
+fn a_phase_that_would_put_a_sphere_into_the_wall_is_refused() {
+    let src = r#"
+        let s = scene();
+        s.model = "rigid";
+        s.wall = #{ z: 0.0 };
+        // Sphere 1 sits 5e-8 m above the wall at phase 0; at phase pi/2 the stroke lengthens the
+        // dumbbell by lambda and pushes it 2e-7 m into the wall.
+        s.add(dumbbell(#{ center: [0.0, 0.0, 3.3e-6], dir: [0.0, 0.0, 1.0] }));
+        let refused = false;
+        try { s.set_phase(0, pi() / 2.0); } catch (e) { refused = true; }
+        if !refused || s.phases[0] != 0.0 { throw "set_phase was not refused"; }
+        refused = false;
+        try { s.phases = [pi() / 2.0]; } catch (e) { refused = true; }
+        if !refused || s.phases[0] != 0.0 { throw "s.phases was not refused"; }
+        s.set_phase(0, -pi() / 2.0);                   // shorter: allowed
+        if s.observe(wall_gap()) <= 0.0 { throw "gap"; }
+    "#;
+    swimlab::script::run_source("phase into the wall", src, &mut rhai::Scope::new())
+        .unwrap_or_else(|e| panic!("{e}"));
+}

@@ -532,12 +532,23 @@ impl Scene {
         self.backend = b;
     }
 
-    /// Set the stroke phase φ of swimmer `i` (rad).
+    /// Set the stroke phase φ of swimmer `i` (rad). Where the phase places the spheres (the
+    /// rigid-stroke and averaged models), a phase that would put one into the wall is refused and
+    /// the scene kept.
     pub fn set_phase(&mut self, i: usize, phase: f64) -> Result<()> {
         self.check_index(i)?;
         require_finite("phase", phase)?;
+        let old = self.swimmers[i].phase;
         self.swimmers[i].phase = phase;
-        Ok(())
+        self.keep_above_wall(|s| s.swimmers[i].phase = old)
+    }
+
+    /// Undo a change with `undo` if it left a sphere at or below the wall, and say which.
+    fn keep_above_wall(&mut self, undo: impl FnOnce(&mut Self)) -> Result<()> {
+        let Some(w) = self.wall else {
+            return Ok(());
+        };
+        self.check_above(&w).inspect_err(|_| undo(self))
     }
 
     /// All stroke phases φ (rad), in swimmer order.
@@ -557,10 +568,15 @@ impl Scene {
         for (i, p) in phases.iter().enumerate() {
             require_finite(&format!("phases[{i}]"), *p)?;
         }
+        let old = self.phases();
         for (d, p) in self.swimmers.iter_mut().zip(phases) {
             d.phase = *p;
         }
-        Ok(())
+        self.keep_above_wall(|s| {
+            for (d, p) in s.swimmers.iter_mut().zip(old) {
+                d.phase = p;
+            }
+        })
     }
 
     // ----- reading ---------------------------------------------------------------------------
