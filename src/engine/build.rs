@@ -111,6 +111,32 @@ pub fn random_suspension_apart(
     for side in sides {
         require_positive("box side", side, "m")?;
     }
+    place_apart(scene, n, d, seed, gap, |rng| {
+        let u = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5);
+        let c = u.component_mul(&Vector3::from(sides));
+        let dir = match orientations {
+            Orientations::Random => rng.unit_vector(),
+            Orientations::Aligned(v) => v,
+        };
+        let phase = match phases {
+            Phases::Random => 2.0 * PI * rng.uniform(),
+            Phases::Equal(p) => p,
+        };
+        (c, dir, phase)
+    })
+}
+
+/// Add `n` copies of `d` drawn by `draw` (centre, orientation, phase from the seeded generator)
+/// by random sequential addition: a draw whose spheres would come within `gap` (at least what
+/// the strokes can close) of a placed sphere, or into a wall, is drawn again.
+pub fn place_apart(
+    scene: &mut Scene,
+    n: usize,
+    d: Dumbbell,
+    seed: u64,
+    gap: Option<f64>,
+    mut draw: impl FnMut(&mut Rng) -> (Vector3<f64>, Vector3<f64>, f64),
+) -> Result<()> {
     if n > MAX_RANDOM_SWIMMERS {
         return Err(invalid!(
             "cannot place {n} swimmers at random in one call: one call places at most {MAX_RANDOM_SWIMMERS} (a scene that size holds ~0.3 GB and takes seconds a step); place fewer"
@@ -155,17 +181,8 @@ pub fn random_suspension_apart(
                 "placed only {placed} of {n} swimmers without overlaps after {max_tries} tries; use a larger box or a lower volume fraction"
             ));
         }
-        let u = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5);
-        let c = u.component_mul(&Vector3::from(sides));
-        let dir = match orientations {
-            Orientations::Random => rng.unit_vector(),
-            Orientations::Aligned(v) => v,
-        };
+        let (c, dir, phase) = draw(&mut rng);
         let dir = unit_direction(dir)?;
-        let phase = match phases {
-            Phases::Random => 2.0 * PI * rng.uniform(),
-            Phases::Equal(p) => p,
-        };
         let new = Dumbbell { phase, ..d };
         let (x1, x2) = new.sphere_positions(c, dir, scene.contact_length(&new));
         // Above a wall only places clear of it count (one sphere's stroke closes half the

@@ -210,48 +210,15 @@ impl Field {
         let n = self.grid;
         let comps = self.kind.components();
         let dv = self.spacing[0] * self.spacing[1] * self.spacing[2];
-        // Per swimmer and axis: the cells within 4 widths and their 1D Gaussian factors (the
-        // kernel is separable), each cell once even where 4 widths exceed half a box.
         let axis = |c: f64, d: usize| -> Vec<(usize, f64)> {
-            let (h, o, w) = (self.spacing[d], self.origin[d], self.width);
-            let reach = (4.0 * w / h).ceil() as i64;
-            let centre = ((c - o) / h).round() as i64;
-            let (lo, hi) = match sides {
-                Some(_) => {
-                    let half = (n[d] as i64 - 1) / 2;
-                    let m = reach.min(half);
-                    (
-                        centre - m,
-                        centre
-                            + m
-                            + if n[d].is_multiple_of(2) && reach > half {
-                                1
-                            } else {
-                                0
-                            },
-                    )
-                }
-                None => (
-                    (centre - reach).max(0),
-                    (centre + reach).min(n[d] as i64 - 1),
-                ),
-            };
-            (lo..=hi)
-                .map(|i| {
-                    let x = o + i as f64 * h;
-                    let dx = match sides {
-                        Some(l) => {
-                            let r = x - c;
-                            r - l[d] * (r / l[d]).round()
-                        }
-                        None => x - c,
-                    };
-                    (
-                        i.rem_euclid(n[d] as i64) as usize,
-                        (-dx * dx / (2.0 * w * w)).exp(),
-                    )
-                })
-                .collect()
+            gaussian_axis(
+                c,
+                self.spacing[d],
+                self.origin[d],
+                self.width,
+                n[d],
+                sides.map(|l| l[d]),
+            )
         };
         let mut rho = vec![0.0; n[0] * n[1] * n[2]];
         for (c, dir) in centres.iter().zip(dirs) {
@@ -433,6 +400,55 @@ impl Field {
         };
         super::vtk::xml_with_units(vtk, &[("length_unit", "um"), unit], "the VTK image")
     }
+}
+
+/// One axis of the separable Gaussian kernel of width `w` about coordinate `c`: the cells within
+/// 4 widths (cell i centred at `origin` + i·`h`, `n` cells) and their factors e^{−dx²/2w²}, by
+/// minimum image when the axis is periodic with side `side` (each cell once even where 4 widths
+/// exceed half the side).
+pub(crate) fn gaussian_axis(
+    c: f64,
+    h: f64,
+    o: f64,
+    w: f64,
+    n: usize,
+    side: Option<f64>,
+) -> Vec<(usize, f64)> {
+    let reach = (4.0 * w / h).ceil() as i64;
+    let centre = ((c - o) / h).round() as i64;
+    let (lo, hi) = match side {
+        Some(_) => {
+            let half = (n as i64 - 1) / 2;
+            let m = reach.min(half);
+            (
+                centre - m,
+                centre
+                    + m
+                    + if n.is_multiple_of(2) && reach > half {
+                        1
+                    } else {
+                        0
+                    },
+            )
+        }
+        None => ((centre - reach).max(0), (centre + reach).min(n as i64 - 1)),
+    };
+    (lo..=hi)
+        .map(|i| {
+            let x = o + i as f64 * h;
+            let dx = match side {
+                Some(l) => {
+                    let r = x - c;
+                    r - l * (r / l).round()
+                }
+                None => x - c,
+            };
+            (
+                i.rem_euclid(n as i64) as usize,
+                (-dx * dx / (2.0 * w * w)).exp(),
+            )
+        })
+        .collect()
 }
 
 /// A 2D slice of a field's cell scalars for a heat map.

@@ -73,7 +73,7 @@ pub struct CutoffSwitch {
 }
 
 impl CutoffSwitch {
-    pub(super) fn new(cutoff: Option<f64>) -> Self {
+    pub(crate) fn new(cutoff: Option<f64>) -> Self {
         match cutoff {
             Some(c) if c.is_finite() => CutoffSwitch {
                 inner: (1.0 - CUTOFF_SWITCH_WIDTH) * c,

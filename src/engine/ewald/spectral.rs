@@ -21,13 +21,12 @@
 use super::{truncation, Split};
 use crate::engine::cells::CellGrid;
 use crate::engine::error::{invalid, Result};
+use crate::engine::fft3::{signed_mode, Fft3};
 use crate::engine::periodic::PeriodicBox;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
-use rustfft::{Fft, FftPlanner};
 use std::f64::consts::PI;
-use std::sync::Arc;
 
 /// The largest grid (points) the method builds: 3 fields of 2^22 complex points and their
 /// transposes take 400 MB.
@@ -89,7 +88,7 @@ pub struct SpectralEwald {
     /// 1/(6πμ).
     kernel: Vec<f64>,
     /// Forward and inverse transforms per axis.
-    fft: [[Arc<dyn Fft<f64>>; 2]; 3],
+    fft: Fft3,
 }
 
 impl std::fmt::Debug for SpectralEwald {
@@ -212,13 +211,7 @@ impl SpectralEwald {
                     }
                 }
             });
-        let mut planner = FftPlanner::new();
-        let fft = [0, 1, 2].map(|a| {
-            [
-                planner.plan_fft_forward(m[a]),
-                planner.plan_fft_inverse(m[a]),
-            ]
-        });
+        let fft = Fft3::new(m);
         Ok(SpectralEwald {
             periodic,
             split: Split { xi, ..split },
@@ -469,26 +462,15 @@ impl SpectralEwald {
     /// Forward transforms of the three fields: x rows, then (transposed) y rows, then z rows. The
     /// result is in `grid` with z fastest, then y, then x.
     fn forward(&self, grid: &mut [Vec<Complex64>; 3], spare: &mut [Vec<Complex64>; 3]) {
-        let [mx, my, mz] = self.m;
-        for q in 0..3 {
-            rows(&*self.fft[0][0], &mut grid[q], mx * my);
-            transpose_planes(&grid[q], &mut spare[q], mx, my);
-            rows(&*self.fft[1][0], &mut spare[q], my * mx);
-            // (y, x, z) → (z, y, x).
-            yxz_to_zyx(&spare[q], &mut grid[q], self.m);
-            rows(&*self.fft[2][0], &mut grid[q], mz * my);
+        for (g, s) in grid.iter_mut().zip(spare.iter_mut()) {
+            self.fft.forward(g, s);
         }
     }
 
     /// Inverse transforms of the three fields in `grid` (z fastest), back to x fastest in `grid`.
     fn inverse(&self, grid: &mut [Vec<Complex64>; 3], spare: &mut [Vec<Complex64>; 3]) {
-        let [mx, my, mz] = self.m;
-        for q in 0..3 {
-            rows(&*self.fft[2][1], &mut grid[q], mz * my);
-            zyx_to_yxz(&grid[q], &mut spare[q], self.m);
-            rows(&*self.fft[1][1], &mut spare[q], my * mx);
-            transpose_planes(&spare[q], &mut grid[q], my, mx);
-            rows(&*self.fft[0][1], &mut grid[q], mx * my);
+        for (g, s) in grid.iter_mut().zip(spare.iter_mut()) {
+            self.fft.inverse(g, s);
         }
     }
 
@@ -560,15 +542,6 @@ impl SpectralEwald {
     }
 }
 
-/// The wave index of FFT output `i` of `n`: i up to n/2, i − n above.
-fn signed_mode(i: usize, n: usize) -> f64 {
-    if i <= n / 2 {
-        i as f64
-    } else {
-        i as f64 - n as f64
-    }
-}
-
 /// The support's P points along x from grid index `start` in a row of `m` points, as at most two
 /// runs (grid index, first weight, length): the second one after the wrap.
 fn x_runs(start: usize, p: usize, m: usize) -> ([(usize, usize, usize); 2], usize) {
@@ -578,57 +551,6 @@ fn x_runs(start: usize, p: usize, m: usize) -> ([(usize, usize, usize); 2], usiz
         let first = m - start;
         ([(start, 0, first), (0, first, p - first)], 2)
     }
-}
-
-/// Transform every contiguous row of length `fft.len()` of `data`, in parallel chunks of
-/// `chunk` points (a multiple of the row length).
-fn rows(fft: &dyn Fft<f64>, data: &mut [Complex64], chunk: usize) {
-    let scratch_len = fft.get_inplace_scratch_len();
-    data.par_chunks_mut(chunk).for_each_init(
-        || vec![Complex64::default(); scratch_len],
-        |scratch, c| fft.process_with_scratch(c, scratch),
-    );
-}
-
-/// Each plane of `src` (`rows` rows of `cols` points) transposed into `dst`: dst[r + rows·c] =
-/// src[c + cols·r], plane by plane ((x, y, z) ↔ (y, x, z) layouts, each's first index fastest).
-fn transpose_planes(src: &[Complex64], dst: &mut [Complex64], cols: usize, rows: usize) {
-    dst.par_chunks_mut(cols * rows)
-        .zip(src.par_chunks(cols * rows))
-        .for_each(|(to, from)| {
-            for c in 0..cols {
-                for r in 0..rows {
-                    to[r + rows * c] = from[c + cols * r];
-                }
-            }
-        });
-}
-
-/// dst(z, y, x) = src(y, x, z).
-fn yxz_to_zyx(src: &[Complex64], dst: &mut [Complex64], [mx, my, mz]: [usize; 3]) {
-    dst.par_chunks_mut(mz * my)
-        .enumerate()
-        .for_each(|(x, slab)| {
-            for z in 0..mz {
-                let from = &src[my * (x + mx * z)..my * (x + mx * z) + my];
-                for (y, v) in from.iter().enumerate() {
-                    slab[z + mz * y] = *v;
-                }
-            }
-        });
-}
-
-/// dst(y, x, z) = src(z, y, x).
-fn zyx_to_yxz(src: &[Complex64], dst: &mut [Complex64], [mx, my, mz]: [usize; 3]) {
-    dst.par_chunks_mut(my * mx)
-        .enumerate()
-        .for_each(|(z, plane)| {
-            for x in 0..mx {
-                for y in 0..my {
-                    plane[y + my * x] = src[z + mz * (y + my * x)];
-                }
-            }
-        });
 }
 
 #[cfg(test)]
