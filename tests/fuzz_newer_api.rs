@@ -247,6 +247,28 @@ const CALLS: &[&str] = &[
     "lattice::hexagonal(V, V, 1e-5)",
     "1.0 / V",
     "V + s",
+    // The continuum.
+    "continuum(b, V)",
+    "continuum(s, V)",
+    "continuum(V)",
+    "c.run_periods(V)",
+    "c.run(V)",
+    "c.field(V)",
+    "c.field(V, V)",
+    "c.mode(V, V)",
+    "c.mode(V, V, V)",
+    "b.mode(V, V)",
+    "b.mode(V, V, V)",
+    "s.mode(V, V)",
+    "c.growth_rates(V)",
+    "c.growth_rates(V, V)",
+    "c.perturb(V)",
+    "c.perturb(#{ shape: V, amplitude: V, mode: V, axis: V })",
+    "c.sample(b, V, V)",
+    "c.sample(s, V, V)",
+    "c.wave_vector(V)",
+    "c.counts()",
+    "display(c)",
 ];
 
 /// The scenes a script starts from.
@@ -261,8 +283,9 @@ const PROLOGUES: &[&str] = &[
     "let s = scene();\ns.model = \"averaged\";\ns.add(dumbbell(#{ center: [-25e-6, 0, 0] }));\ns.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 }));\n",
 ];
 
-/// Every script has a box scene `b`, a recorder `r` and a field `f` besides its `s`.
-const COMMON: &str = "let b = scene();\nb.box = [120e-6, 120e-6, 120e-6];\nb.add(dumbbell(#{ center: [-30e-6, 0, 0] }));\nb.add(dumbbell(#{ phase: 1.0 }));\nlet d = dumbbell();\nlet r = s.record([R_H(0)], 1);\nlet f = s.field(\"density\", #{ grid: [8, 8, 8] });\n";
+/// Every script has a box scene `b`, a recorder `r`, a field `f` and a continuum `c` of `b`
+/// besides its `s`.
+const COMMON: &str = "let b = scene();\nb.box = [120e-6, 120e-6, 120e-6];\nb.add(dumbbell(#{ center: [-30e-6, 0, 0] }));\nb.add(dumbbell(#{ phase: 1.0 }));\nlet d = dumbbell();\nlet r = s.record([R_H(0)], 1);\nlet f = s.field(\"density\", #{ grid: [8, 8, 8] });\nlet c = continuum(b, #{ grid: 4, orientations: 2 });\n";
 
 fn script(rng: &mut Rng, paths: &[String]) -> String {
     let p: Vec<&str> = paths.iter().map(String::as_str).collect();

@@ -2,6 +2,7 @@
 //! the examples; one error renderer ([`render_error`]).
 
 pub mod console;
+mod continuum_api;
 mod convert;
 mod csv_api;
 mod doc;

@@ -122,7 +122,7 @@ impl SceneHandle {
     }
 
     /// Put `trial` in place of the scene (the recorders stay); returns the new count.
-    fn replace(&self, trial: Scene) -> ScriptResult<INT> {
+    pub(super) fn replace(&self, trial: Scene) -> ScriptResult<INT> {
         let mut sim = self.borrow_mut()?;
         sim.replace_scene(trial);
         Ok(sim.count() as INT)

@@ -4,6 +4,7 @@
 //! euler(1e-6) (Integrator)"). Rhai's own messages name custom types by their Rust paths; [`in_words`]
 //! rewrites those, so no Rust path reaches a user.
 
+use super::continuum_api::ContinuumHandle;
 use super::dumbbell_api::DumbbellSpec;
 use super::observable_api::RecorderHandle;
 use super::picture_api::Picture;
@@ -56,6 +57,7 @@ script_types! {
     RecorderHandle => "Recorder",
     Field => "Field",
     Picture => "Picture",
+    ContinuumHandle => "Continuum",
 }
 
 /// A function pointer's text: `Fn(name)`, or `Fn(a closure)` for a closure, whose function has a

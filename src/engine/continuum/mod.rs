@@ -25,11 +25,13 @@ pub use stability::{BaseState, Mode};
 use self::kernel::{Component, Constants, Radial};
 use self::sphere::{monomial, monomials, Sphere, MAX_DEGREE};
 use super::averaged::pair_constants;
+use super::build::place_apart;
 use super::error::{invalid, Result};
 use super::fft3::{signed_mode, Fft3};
 use super::fields::{gaussian_axis, Field, FieldKind};
 use super::integrators::{Dopri5, OdeSystem, Problem, Stats, Stepper};
 use super::scene::Scene;
+use super::swimmer::Dumbbell;
 use super::thermal::RigidDiffusion;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
@@ -134,6 +136,9 @@ pub struct Continuum {
     cutoff: f64,
     period: f64,
     tol: f64,
+    /// The swimmer kind (phase aside).
+    kind: Dumbbell,
+    interrupt: Option<super::integrators::Interrupt>,
 }
 
 impl std::fmt::Debug for Continuum {
@@ -248,6 +253,8 @@ impl Continuum {
             cutoff,
             period: first.period(),
             tol: spec.tol,
+            kind: first,
+            interrupt: None,
         };
         c.filter_state();
         Ok(c)
@@ -276,6 +283,11 @@ impl Continuum {
         }
     }
 
+    /// Ask `interrupt` between steps: when it answers true the run stops there, state kept.
+    pub fn set_interrupt(&mut self, interrupt: Option<super::integrators::Interrupt>) {
+        self.interrupt = interrupt;
+    }
+
     /// Advance by `seconds`. On an error the state is the last accepted one.
     pub fn run(&mut self, seconds: f64) -> Result<()> {
         if !(seconds.is_finite() && seconds >= 0.0) {
@@ -285,6 +297,9 @@ impl Continuum {
         }
         let end = self.time + seconds;
         while self.time < end {
+            if self.interrupt.as_ref().is_some_and(|stop| stop()) {
+                return Err(super::error::EngineError::Interrupted { time: self.time });
+            }
             match self.stepper.step(
                 &mut self.kinetic,
                 self.time,
@@ -655,6 +670,11 @@ impl Continuum {
         amplitude: f64,
         population: Option<usize>,
     ) -> Result<()> {
+        if !amplitude.is_finite() {
+            return Err(invalid!(
+                "a perturbation's amplitude must be a finite number, got {amplitude}"
+            ));
+        }
         let coef = self.base_coefficients(base)?;
         let op = &self.kinetic.op;
         let b = op.sphere.len();
@@ -708,6 +728,145 @@ impl Continuum {
         self.stepper.reset();
         Ok(())
     }
+}
+
+impl Continuum {
+    /// Add `n` swimmers of the continuum's kind to `scene` drawn from its distribution: a
+    /// population in proportion to its number, a cell in proportion to its density there (the
+    /// density clipped at 0: a truncated distribution can dip below), a place uniform in the cell,
+    /// an orientation from f_p at the cell's centre (rejection, f clipped at 0), the population's
+    /// phase; draws that would bring spheres within `gap` of others are drawn again (as
+    /// `add_random`). All or nothing. The scene needs the continuum's box.
+    pub fn sample(&self, scene: &mut Scene, n: usize, seed: u64, gap: Option<f64>) -> Result<()> {
+        let same_box = scene.periodic().is_some_and(|b| {
+            b.sides()
+                .iter()
+                .zip(&self.sides)
+                .all(|(a, b)| (a - b).abs() <= 1e-12 * a.abs())
+        });
+        if !same_box {
+            return Err(invalid!(
+                "swimmers drawn from a continuum go into a scene with the continuum's box {:?} m; set s.box to it first",
+                self.sides
+            ));
+        }
+        let k = &self.kind;
+        let filled = (scene.count() + n) as f64 * 4.0 / 3.0 * PI * (k.a1.powi(3) + k.a2.powi(3))
+            / self.sides.iter().product::<f64>();
+        if filled > 0.05 {
+            return Err(invalid!(
+                "{n} more swimmers would fill {:.1}% of the box with spheres; draws from a continuum are for dilute suspensions (at most 5%), which is what its mean field describes: draw fewer",
+                100.0 * filled
+            ));
+        }
+        let op = &self.kinetic.op;
+        let b = op.sphere.len();
+        let cells = op.cells;
+        let nn = op.sphere.node_count();
+        // Per population, the cumulative clipped density over the cells; per cell and node, f.
+        let mut cum: Vec<Vec<f64>> = Vec::new();
+        let mut at_nodes: Vec<Vec<f64>> = Vec::new();
+        for p in 0..self.kinetic.pops {
+            let mut f = vec![0.0; cells * nn];
+            let mut c = vec![0.0; b];
+            let mut acc = 0.0;
+            let mut row = Vec::with_capacity(cells);
+            for cell in 0..cells {
+                for (i, ci) in c.iter_mut().enumerate() {
+                    *ci = self.state[(p * b + i) * cells + cell];
+                }
+                op.sphere.evaluate(&c, &mut f[cell * nn..(cell + 1) * nn]);
+                acc += (c[0] * (4.0 * PI).sqrt()).max(0.0);
+                row.push(acc);
+            }
+            cum.push(row);
+            at_nodes.push(f);
+        }
+        let totals: Vec<f64> = cum.iter().map(|r| *r.last().unwrap_or(&0.0)).collect();
+        let all: f64 = totals.iter().sum();
+        if all.is_nan() || all <= 0.0 {
+            return Err(invalid!("the continuum holds no swimmers to draw"));
+        }
+        let h: [f64; 3] = std::array::from_fn(|d| self.sides[d] / self.grid[d] as f64);
+        let [nx, ny, _] = self.grid;
+        let sphere = &op.sphere;
+        let draw = |rng: &mut super::build::Rng| {
+            let mut u = rng.uniform() * all;
+            let mut p = 0;
+            while p + 1 < totals.len() && u >= totals[p] {
+                u -= totals[p];
+                p += 1;
+            }
+            let cell = cum[p].partition_point(|x| *x <= u).min(cells - 1);
+            let idx = [cell % nx, (cell / nx) % ny, cell / (nx * ny)];
+            let c = nalgebra::Vector3::from_fn(|d, _| {
+                -0.5 * self.sides[d] + (idx[d] as f64 + rng.uniform()) * h[d]
+            });
+            let f = &at_nodes[p][cell * nn..(cell + 1) * nn];
+            let top = f.iter().fold(0.0f64, |a, x| a.max(*x)) * 1.2;
+            let mut dir = rng.unit_vector();
+            for _ in 0..1000 {
+                let y = sphere.basis_at(&[dir.x, dir.y, dir.z]);
+                let c = &self.state;
+                let value: f64 = (0..b).map(|i| y[i] * c[(p * b + i) * cells + cell]).sum();
+                if rng.uniform() * top <= value.max(0.0) {
+                    break;
+                }
+                dir = rng.unit_vector();
+            }
+            (c, dir, self.populations[p].phase)
+        };
+        let mut trial = scene.clone();
+        place_apart(&mut trial, n, self.kind, seed, gap, draw)?;
+        *scene = trial;
+        Ok(())
+    }
+}
+
+/// The Fourier amplitude Σ_σ e^{−ik·R_σ} w_σ of the particles' `kind` (w = 1, N_σ, or
+/// (3N_σN_σ − I)/2 row by row) at box mode `mode` of `scene`'s box, over the swimmers of phase
+/// `phase` (all when `None`): the particles' side of [`Continuum::mode`].
+pub fn particle_mode(
+    scene: &Scene,
+    kind: FieldKind,
+    mode: [i64; 3],
+    phase: Option<f64>,
+) -> Result<Vec<Complex64>> {
+    let Some(b) = scene.periodic() else {
+        return Err(invalid!(
+            "a Fourier mode is taken over a periodic box's wave vectors, and this scene has none; set s.box first"
+        ));
+    };
+    let sides = b.sides();
+    let comps = kind.components();
+    let mut out = vec![Complex64::default(); comps];
+    for (i, d) in scene.swimmers().iter().enumerate() {
+        if let Some(p) = phase {
+            let diff = (d.phase - p).rem_euclid(2.0 * PI);
+            if diff.min(2.0 * PI - diff) > SAME_PHASE {
+                continue;
+            }
+        }
+        let r = scene.shown(scene.center(i)?);
+        let n = scene.dir(i)?;
+        let arg: f64 = (0..3)
+            .map(|a| -2.0 * PI * mode[a] as f64 * r[a] / sides[a])
+            .sum();
+        let e = Complex64::from_polar(1.0, arg);
+        match kind {
+            FieldKind::Density => out[0] += e,
+            FieldKind::Polarization => (0..3).for_each(|a| out[a] += e * n[a]),
+            FieldKind::Nematic => {
+                for a in 0..3 {
+                    for c in 0..3 {
+                        let q = 1.5 * n[a] * n[c] - if a == c { 0.5 } else { 0.0 };
+                        out[3 * a + c] += e * q;
+                    }
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The Fourier amplitude of field `f` (times the density `rho` for Π and Q) at box mode `mode`.

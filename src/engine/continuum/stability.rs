@@ -156,6 +156,12 @@ pub(super) fn linear_operator(
     let nn = op.sphere.node_count();
     let cbar = base_coefficients(op, dens, base)?;
     let kn = (k[0] * k[0] + k[1] * k[1] + k[2] * k[2]).sqrt();
+    let k_max = 128.0 * PI / op.core;
+    if kn > k_max {
+        return Err(invalid!(
+            "the wave vector's length {kn:e} 1/m is beyond what the kernel resolves, {k_max:.3e} 1/m (64 waves across the core); the continuum describes waves longer than the core"
+        ));
+    }
     let radial = Radial::new(op.core, op.cutoff, kn.max(1.0 / op.cutoff));
     let (dirs, dir_w) = kernel::directions();
     let mut scratch = Vec::new();
