@@ -101,21 +101,18 @@ fn unit(v: [f64; 3]) -> [f64; 3] {
     v.map(|x| x / n)
 }
 
-/// A small deterministic generator (SplitMix64) for the tests' samples.
-struct Rng(u64);
+/// The engine's seeded generator, with the tests' draws.
+struct Rng(swimlab::engine::build::Rng);
 impl Rng {
+    fn new(seed: u64) -> Self {
+        Rng(swimlab::engine::build::Rng::new(seed))
+    }
     fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        self.0.uniform()
     }
     fn direction(&mut self) -> [f64; 3] {
-        let z = 2.0 * self.uniform() - 1.0;
-        let phi = 2.0 * PI * self.uniform();
-        let s = (1.0 - z * z).sqrt();
-        [s * phi.cos(), s * phi.sin(), z]
+        let v = self.0.unit_vector();
+        [v.x, v.y, v.z]
     }
 }
 
@@ -146,7 +143,7 @@ fn the_folded_kernel_is_the_pair_terms() {
         let comps = kernel::components(&constants(&d));
         let mut probe = PairProbe::new(&d, None);
         let (dirs, _) = kernel::directions();
-        let mut rng = Rng(7);
+        let mut rng = Rng::new(7);
         for (j, dh) in dirs.iter().enumerate() {
             for dist in [1.5 * d.ell, 4.0 * d.ell] {
                 let (n, np) = (rng.direction(), rng.direction());
@@ -244,7 +241,7 @@ fn two_populations(count: usize, side: f64, seed: u64) -> Scene {
     let mut s = Scene::new();
     s.set_model(Model::Averaged);
     s.set_box(Some([side; 3])).unwrap();
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let d = asymmetric();
     let mut i = 0;
     while i < count {
@@ -528,7 +525,7 @@ fn particles_sampled_from_the_distribution_feel_the_mean_field_on_average() {
     let want = mean_fields(&c, &orientations, &probes);
     let mut probe = PairProbe::new(&d, Some(cutoff));
     let fmax = rho / (4.0 * PI) * 1.5 * 1.9;
-    let mut rng = Rng(11);
+    let mut rng = Rng::new(11);
     let (mut deviations, mut zs) = (Vec::new(), Vec::new());
     let sizes = [500usize, 2000, 8000];
     let outputs = (orientations.len() * probes.len() * 6) as f64;

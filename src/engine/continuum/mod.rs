@@ -700,23 +700,15 @@ impl Continuum {
             .collect();
         let mut g = vec![0.0; b];
         sphere.project(&shape_at, &mut g);
-        let h: [f64; 3] = std::array::from_fn(|d| self.sides[d] / self.grid[d] as f64);
-        let [nx, ny, _] = self.grid;
         let dens = self.mean_densities();
+        let waves = self.cell_phases(mode);
         for p in 0..self.kinetic.pops {
             let hit = population.is_none_or(|q| q == p);
             for i in 0..b {
                 let block = &mut self.state[(p * b + i) * cells..(p * b + i + 1) * cells];
-                for (cell, v) in block.iter_mut().enumerate() {
-                    let idx = [cell % nx, (cell / nx) % ny, cell / (nx * ny)];
-                    let phase: f64 = (0..3)
-                        .map(|d| {
-                            let x = -0.5 * self.sides[d] + (idx[d] as f64 + 0.5) * h[d];
-                            2.0 * PI * mode[d] as f64 * x / self.sides[d]
-                        })
-                        .sum();
+                for (v, e) in block.iter_mut().zip(&waves) {
                     let wave = if hit {
-                        amplitude * dens[p] / (4.0 * PI) * g[i] * phase.cos()
+                        amplitude * dens[p] / (4.0 * PI) * g[i] * e.re
                     } else {
                         0.0
                     };
