@@ -158,13 +158,13 @@ impl Continuum {
     pub fn of(scene: &Scene, spec: &ContinuumSpec) -> Result<Continuum> {
         let Some(b) = scene.periodic() else {
             return Err(invalid!(
-                "a continuum lives in a periodic box and this scene has none; set one first, e.g. s.box = [200e-6, 200e-6, 200e-6]"
+                "a continuum lives in a periodic box and this scene has none; give the scene a box first"
             ));
         };
         let sides = b.sides();
         if scene.count() == 0 {
             return Err(invalid!(
-                "the scene has no swimmers to build a continuum from; add some first, e.g. s.add_random(dumbbell(), 500, 1)"
+                "the scene has no swimmers to build a continuum from; add some first"
             ));
         }
         check_spec(spec)?;
@@ -738,7 +738,7 @@ impl Continuum {
         });
         if !same_box {
             return Err(invalid!(
-                "swimmers drawn from a continuum go into a scene with the continuum's box {:?} m; set s.box to it first",
+                "swimmers drawn from a continuum go into a scene with the continuum's box {:?} m; give the scene that box first",
                 self.sides
             ));
         }
@@ -954,7 +954,7 @@ fn populations(phases: &[f64], bins: Option<usize>) -> Result<(Vec<Population>, 
             None => {
                 if pops.len() == MAX_POPULATIONS {
                     return Err(invalid!(
-                        "the swimmers have more than {MAX_POPULATIONS} distinct phases; bin them, e.g. continuum(s, #{{ phases: 8 }})"
+                        "the swimmers have more than {MAX_POPULATIONS} distinct phases; bin them into at most {MAX_POPULATIONS} populations (the continuum's phases option)"
                     ));
                 }
                 member.push(pops.len());
