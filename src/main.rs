@@ -175,11 +175,10 @@ fn main() -> ExitCode {
     } else {
         match cli.command {
             Some(Command::Reference) => {
-                print!("{}", swimlab::repl::reference::markdown());
-                Ok(())
+                swimlab::script::console::emit(&swimlab::repl::reference::markdown())
             }
             Some(Command::Bench { which, quick }) => {
-                swimlab::bench::report::run(which.into(), quick)
+                swimlab::bench::report::run(which.into(), quick, &swimlab::script::console::emit_line)
             }
             Some(Command::Sweep {
                 script,
@@ -222,8 +221,11 @@ fn main() -> ExitCode {
                         Some(p) => swimlab::repl::kernel::spec::Target::Prefix(p),
                         None => swimlab::repl::kernel::spec::Target::User,
                     };
-                    swimlab::repl::kernel::spec::install(&target).map(|dir| {
-                        println!("installed the swimlab kernel in {}", dir.display())
+                    swimlab::repl::kernel::spec::install(&target).and_then(|dir| {
+                        swimlab::script::console::emit_line(&format!(
+                            "installed the swimlab kernel in {}",
+                            dir.display()
+                        ))
                     })
                 }
                 (None, Some(file)) => swimlab::repl::kernel::run(&file),
@@ -263,9 +265,9 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(msg) => {
-            eprint!("{msg}");
+            swimlab::script::console::to_stderr(&msg);
             if swimlab::script::interrupt::requested() {
-                eprintln!("swimlab: stopped by Ctrl-C (SIGINT); rows streamed to files are complete up to that point");
+                swimlab::script::console::to_stderr("swimlab: stopped by Ctrl-C (SIGINT); rows streamed to files are complete up to that point\n");
                 // The shell convention for a process ended by SIGINT.
                 ExitCode::from(130)
             } else {

@@ -5,6 +5,7 @@
 //! cluster's results equal a laptop's. `index.csv` lists every point: index, parameters, status,
 //! wall time.
 
+use crate::script::console;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -134,7 +135,7 @@ impl Sweep {
         let todo: Vec<usize> = (0..n)
             .filter(|&k| !(self.resume && status_of(&self.folder(k)).is_some_and(|s| s.ok)))
             .collect();
-        println!(
+        console::emit_line(&format!(
             "swimlab sweep: {n} points ({} to run{}) of {} on {} processes, into {}",
             todo.len(),
             if self.resume {
@@ -145,7 +146,7 @@ impl Sweep {
             self.script.display(),
             self.jobs.min(todo.len().max(1)),
             self.out.display()
-        );
+        ))?;
         let next = AtomicUsize::new(0);
         let index_lock = Mutex::new(());
         std::thread::scope(|scope| {
@@ -158,9 +159,13 @@ impl Sweep {
                     }
                     let outcome = self.run_point(k, &points[k]);
                     let _guard = index_lock.lock().unwrap_or_else(|e| e.into_inner());
-                    println!("  point {k} ({}): {}", describe(&points[k]), outcome.text());
+                    console::to_stdout(&format!(
+                        "  point {k} ({}): {}\n",
+                        describe(&points[k]),
+                        outcome.text()
+                    ));
                     if let Err(e) = self.write_index(&points) {
-                        eprintln!("{e}");
+                        console::to_stderr(&e);
                     }
                 });
             }
@@ -180,7 +185,11 @@ impl Sweep {
         }
         let points = self.points();
         let outcome = self.run_point(k, &points[k]);
-        println!("point {k} ({}): {}", describe(&points[k]), outcome.text());
+        console::emit_line(&format!(
+            "point {k} ({}): {}",
+            describe(&points[k]),
+            outcome.text()
+        ))?;
         self.write_index(&points)?;
         if outcome.ok {
             Ok(())
@@ -240,12 +249,12 @@ impl Sweep {
         }
         self.resume = false;
         self.write_index(&self.points())?;
-        println!(
+        console::emit_line(&format!(
             "wrote {} ({n} tasks, --array=0-{}); submit it with: sbatch {}",
             path.display(),
             n - 1,
             path.display()
-        );
+        ))?;
         Ok(())
     }
 
@@ -333,12 +342,12 @@ impl Sweep {
         let failed: Vec<usize> = (0..points.len())
             .filter(|&k| !status_of(&self.folder(k)).is_some_and(|s| s.ok))
             .collect();
-        println!(
+        console::emit_line(&format!(
             "{} of {} points ok; index: {}",
             points.len() - failed.len(),
             points.len(),
             self.out.join("index.csv").display()
-        );
+        ))?;
         if failed.is_empty() {
             Ok(())
         } else {

@@ -23,8 +23,13 @@ pub enum Kind {
     Suspension,
 }
 
-/// Run one benchmark, print its tables and write its CSV and pictures under out/bench/.
-pub fn run(which: Kind, quick: bool) -> Result<(), String> {
+/// Run one benchmark, tell `say` its tables line by line (the command line prints them) and
+/// write its CSV and pictures under out/bench/.
+pub fn run(
+    which: Kind,
+    quick: bool,
+    say: &dyn Fn(&str) -> Result<(), String>,
+) -> Result<(), String> {
     let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
     match which {
         Kind::WorkPrecision => {
@@ -43,73 +48,73 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
             ] {
                 let points = work_precision::run(&models, periods, repeats, quick);
                 let t = work_precision::table(&points);
-                println!("\n{label}, {periods} periods (errors relative to the converged reference; * = Pareto front):\n{}", t.render());
-                println!(
+                say(&format!("\n{label}, {periods} periods (errors relative to the converged reference; * = Pareto front):\n{}", t.render()))?;
+                say(&format!(
                     "\nfastest method per error level of the drift:\n{}",
                     work_precision::winners(&points).render()
-                );
+                ))?;
                 t.write_csv(&std::path::Path::new("out/bench").join(file))
                     .map_err(io)?;
                 for (k, (config, ..)) in work_precision::CONFIGS.iter().enumerate() {
                     if let Some(f) = plots::work_precision(&points, config) {
                         let png = format!("out/bench/{}_{k}.png", file.trim_end_matches(".csv"));
                         f.save(std::path::Path::new(&png))?;
-                        println!("picture: {png}");
+                        say(&format!("picture: {png}"))?;
                     }
                 }
             }
             let long = if quick { 200.0 } else { 1e4 };
             let points = work_precision::long_horizon(long);
             let t = work_precision::table(&points);
-            println!("\nlong horizon, spring model, {long} periods (errors against dopri5(1e-10) run directly; * = Pareto front):\n{}", t.render());
+            say(&format!("\nlong horizon, spring model, {long} periods (errors against dopri5(1e-10) run directly; * = Pareto front):\n{}", t.render()))?;
             t.write_csv(std::path::Path::new("out/bench/work_precision_long.csv"))
                 .map_err(io)?;
             if let Some(p) = points.first() {
                 if let Some(f) = plots::work_precision(&points, &p.config) {
                     let png = "out/bench/work_precision_long.png";
                     f.save(std::path::Path::new(png))?;
-                    println!("picture: {png}");
+                    say(&format!("picture: {png}"))?;
                 }
             }
-            println!("\nCSV written to out/bench/");
+            say("\nCSV written to out/bench/")?;
         }
         Kind::Stability => {
             let rows = stability::run(quick);
             let t = stability::table(&rows);
-            println!("largest stable step (bisection on dt*rate, 4 periods of an isolated asymmetric dumbbell):\n{}", t.render());
+            say(&format!("largest stable step (bisection on dt*rate, 4 periods of an isolated asymmetric dumbbell):\n{}", t.render()))?;
             t.write_csv(std::path::Path::new("out/bench/stability.csv"))
                 .map_err(io)?;
-            println!("\nCSV written to out/bench/stability.csv");
+            say("\nCSV written to out/bench/stability.csv")?;
         }
         Kind::Pairs => {
             let n = 4096;
             let t = pairs::run(n, if quick { 3 } else { 11 });
-            println!(
+            say(&format!(
                 "RPY product u_i = sum_j H_ij F_j, N = {n} spheres, N(N-1) interactions per product, vector unit {} (medians):\n{}",
                 crate::engine::simd::vector_unit(),
                 t.render()
-            );
+            ))?;
             t.write_csv(std::path::Path::new("out/bench/pairs.csv"))
                 .map_err(io)?;
-            println!("\nCSV written to out/bench/pairs.csv");
+            say("\nCSV written to out/bench/pairs.csv")?;
         }
         Kind::Ewald => {
             let tol = crate::engine::ewald::DEFAULT_EWALD_TOL;
             let (max, beenakker_max) = if quick { (512, 512) } else { (15625, 4096) };
             let rows = ewald::run(max, beenakker_max, tol)?;
             let t = ewald::table(&rows);
-            println!(
+            say(&format!(
                 "periodic RPY product u = M F in a cube, tolerance {tol:e}, one sphere per (8 um)^3 on a jittered lattice ({} threads; medians of 3-5; open space: the all-pairs kernel at the same positions):\n{}",
                 rayon::current_num_threads(),
                 t.render()
-            );
+            ))?;
             match ewald::crossover(&rows) {
-                Some(n) => println!("spectral is faster from {n} spheres in this table; \"auto\" switches at {}", ewald::auto_threshold()),
-                None => println!("spectral is not faster at any size measured with both; \"auto\" switches at {}", ewald::auto_threshold()),
+                Some(n) => say(&format!("spectral is faster from {n} spheres in this table; \"auto\" switches at {}", ewald::auto_threshold()))?,
+                None => say(&format!("spectral is not faster at any size measured with both; \"auto\" switches at {}", ewald::auto_threshold()))?,
             }
             t.write_csv(std::path::Path::new("out/bench/ewald.csv"))
                 .map_err(io)?;
-            println!("\nCSV written to out/bench/ewald.csv");
+            say("\nCSV written to out/bench/ewald.csv")?;
         }
         Kind::Scaling => {
             let rows = scaling::run(if quick { 256 } else { 4096 })?;
@@ -117,7 +122,7 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
             let gpu = rows
                 .iter()
                 .any(|r| r.line.backend == crate::engine::Backend::Gpu);
-            println!(
+            say(&format!(
                 "cost per stroke period ({} CPU threads{}; lattice scenes 3 ell apart, RK4: micro at its default step, averaged one step per period; the cutoff series up to 8x larger):\n{}",
                 rayon::current_num_threads(),
                 match crate::engine::gpu::device() {
@@ -125,56 +130,59 @@ pub fn run(which: Kind, quick: bool) -> Result<(), String> {
                     Err(_) => "; no GPU adapter: CPU series only".into(),
                 },
                 t.render()
-            );
+            ))?;
             for line in scaling::series(gpu) {
                 for from in [2, 256] {
                     if let Some((k, c)) = scaling::fit(&rows, &line, from) {
-                        println!(
+                        say(&format!(
                             "{}: cost per period ~ {c:.2e} s * S^{k:.2} (fit over S >= {from})",
                             scaling::label(&line)
-                        );
+                        ))?;
                     }
                 }
             }
             t.write_csv(std::path::Path::new("out/bench/scaling.csv"))
                 .map_err(io)?;
             plots::scaling(&rows).save(std::path::Path::new("out/bench/scaling.png"))?;
-            println!("picture: out/bench/scaling.png");
-            println!("\nCSV written to out/bench/scaling.csv");
+            say("picture: out/bench/scaling.png")?;
+            say("\nCSV written to out/bench/scaling.csv")?;
         }
-        Kind::Suspension => run_suspension(quick)?,
+        Kind::Suspension => run_suspension(quick, say)?,
         Kind::Backends => {
             match crate::engine::gpu::device() {
-                Ok(d) => println!("GPU adapter: {}", d.describe()),
-                Err(e) => println!("GPU: {e}"),
+                Ok(d) => say(&format!("GPU adapter: {}", d.describe()))?,
+                Err(e) => say(&format!("GPU: {e}"))?,
             }
             let rows = backends::run(if quick { 1024 } else { 16384 });
             let t = backends::table(&rows);
-            println!("wall time per RK4 step (one process, medians not taken; '-' = over the time budget or no adapter):\n{}", t.render());
+            say(&format!("wall time per RK4 step (one process, medians not taken; '-' = over the time budget or no adapter):\n{}", t.render()))?;
             for m in [Model::Micro, Model::Averaged] {
                 match backends::measured_crossover(&rows, m) {
-                    Some(n) => println!("{}: the GPU is faster from {n} in this table", m.name()),
-                    None => println!(
+                    Some(n) => say(&format!(
+                        "{}: the GPU is faster from {n} in this table",
+                        m.name()
+                    ))?,
+                    None => say(&format!(
                         "{}: the GPU is not faster at any size in this table",
                         m.name()
-                    ),
+                    ))?,
                 }
             }
             for (m, detail) in backends::auto_thresholds() {
-                println!("auto calibration, {}: {detail}", m.name());
+                say(&format!("auto calibration, {}: {detail}", m.name()))?;
             }
             t.write_csv(std::path::Path::new("out/bench/backends.csv"))
                 .map_err(io)?;
             plots::backends(&rows).save(std::path::Path::new("out/bench/backends.png"))?;
-            println!("picture: out/bench/backends.png");
-            println!("\nCSV written to out/bench/backends.csv");
+            say("picture: out/bench/backends.png")?;
+            say("\nCSV written to out/bench/backends.csv")?;
         }
     }
     Ok(())
 }
 
 /// `swimlab bench suspension`: the figures of the bulk suspension (see [`suspension`]).
-fn run_suspension(quick: bool) -> Result<(), String> {
+fn run_suspension(quick: bool, say: &dyn Fn(&str) -> Result<(), String>) -> Result<(), String> {
     let e = |e: crate::engine::EngineError| e.to_string();
     let io = |e: std::io::Error| format!("error: cannot write the CSV: {e}\n");
     let d = crate::engine::Dumbbell::default();
@@ -183,25 +191,27 @@ fn run_suspension(quick: bool) -> Result<(), String> {
     } else {
         (10_000, 1024, 9)
     };
-    println!(
+    say(&format!(
         "one right-hand side, {n} swimmers at phi = 0.1% in a box, cutoff 6 ell (neighbour lists), against {m} swimmers all pairs (lanes), {} threads, vector unit {}, alternating rounds of 5:",
         rayon::current_num_threads(),
         crate::engine::simd::vector_unit()
-    );
+    ))?;
     let bulk = suspension::bulk_scene(n, d, 1e-3, 2026).map_err(e)?;
     let dense = suspension::dense_scene(m, d).map_err(e)?;
     let r = suspension::rhs_rounds(&bulk, &dense, rounds, 5).map_err(e)?;
     let t = suspension::rhs_table(n, m, &r);
-    println!("{}", t.render());
-    println!(
+    say(&t.render())?;
+    say(&format!(
         "median ratio {:.3}",
         suspension::median(r.iter().map(|r| r.suspension / r.dense).collect())
-    );
+    ))?;
     t.write_csv(std::path::Path::new("out/bench/suspension_rhs.csv"))
         .map_err(io)?;
     let placed = if quick { 10_000 } else { 100_000 };
     let secs = suspension::placement_seconds(placed, d, 1e-3, 7).map_err(e)?;
-    println!("\nadd_random of {placed} swimmers in a box at phi = 0.1% with gap: ell: {secs:.2} s");
+    say(&format!(
+        "\nadd_random of {placed} swimmers in a box at phi = 0.1% with gap: ell: {secs:.2} s"
+    ))?;
     let (periods, tols): (f64, &[f64]) = if quick {
         (10.0, &[1e-2, 1e-3])
     } else {
@@ -224,16 +234,16 @@ fn run_suspension(quick: bool) -> Result<(), String> {
             format!("{secs:.2}"),
         ]);
     }
-    println!(
+    say(&format!(
         "\naccuracy: 1,000 swimmers at phi = 0.3% placed ell/2 apart, {periods} periods, suspension(tol) against rk4(T/128) (which differs from rk4(T/256) by {reference:.2e}):\n{}",
         t.render()
-    );
+    ))?;
     for w in rows.windows(2) {
         let order = (w[0].1 / w[1].1).ln() / (w[1].2 as f64 / w[0].2 as f64).ln();
-        println!(
+        say(&format!(
             "error against steps from tol {:e} to {:e}: order {order:.2}",
             w[0].0, w[1].0
-        );
+        ))?;
     }
     t.write_csv(std::path::Path::new("out/bench/suspension_accuracy.csv"))
         .map_err(io)?;
@@ -261,10 +271,10 @@ fn run_suspension(quick: bool) -> Result<(), String> {
         let (_, secs) = *run.stretches.last().unwrap_or(&(0.0, 0.0));
         let st = run.stats;
         if integrator.is_empty() {
-            println!("integrator: {}", run.integrator);
+            say(&format!("integrator: {}", run.integrator))?;
             integrator = run.integrator.clone();
         }
-        println!("{n} swimmers, {periods} periods: {secs:.1} s");
+        say(&format!("{n} swimmers, {periods} periods: {secs:.1} s"))?;
         t.rows.push(vec![
             n.to_string(),
             format!("{periods}"),
@@ -277,9 +287,9 @@ fn run_suspension(quick: bool) -> Result<(), String> {
             st.refined_steps.to_string(),
         ]);
     }
-    println!("\nbulk suspensions at phi = 0.1% (box, cutoff 6 ell, steric rods, the default integrator):\n{}", t.render());
+    say(&format!("\nbulk suspensions at phi = 0.1% (box, cutoff 6 ell, steric rods, the default integrator):\n{}", t.render()))?;
     t.write_csv(std::path::Path::new("out/bench/suspension_runs.csv"))
         .map_err(io)?;
-    println!("\nCSV written to out/bench/suspension_*.csv");
+    say("\nCSV written to out/bench/suspension_*.csv")?;
     Ok(())
 }

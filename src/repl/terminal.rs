@@ -2,7 +2,7 @@
 
 use super::helper::ReplHelper;
 use super::session::{Reply, Session};
-use crate::script::interrupt;
+use crate::script::{console, interrupt};
 use rustyline::error::ReadlineError;
 use rustyline::history::DefaultHistory;
 use rustyline::{CompletionType, Config, Editor};
@@ -62,7 +62,7 @@ fn interactive() -> bool {
     let mut rl: Editor<ReplHelper, DefaultHistory> = match Editor::with_config(config) {
         Ok(rl) => rl,
         Err(e) => {
-            eprintln!("error: cannot start the line editor: {e}");
+            console::to_stderr(&format!("error: cannot start the line editor: {e}\n"));
             return false;
         }
     };
@@ -71,10 +71,10 @@ fn interactive() -> bool {
     if let Some(h) = &history {
         let _ = rl.load_history(h);
     }
-    println!(
-        "swimlab {} — dumbbell swimmers at low Reynolds number. :help lists everything, Ctrl-D leaves.",
+    console::to_stdout(&format!(
+        "swimlab {} — dumbbell swimmers at low Reynolds number. :help lists everything, Ctrl-D leaves.\n",
         env!("CARGO_PKG_VERSION")
-    );
+    ));
     loop {
         match rl.readline(PROMPT) {
             Ok(line) => {
@@ -88,17 +88,17 @@ fn interactive() -> bool {
                 match reply {
                     Reply::Quit => break,
                     Reply::Output(s) if s.is_empty() => {}
-                    Reply::Output(s) => println!("{s}"),
-                    Reply::Error(s) => {
-                        eprint!("{s}{}", if s.ends_with('\n') { "" } else { "\n" })
-                    }
+                    Reply::Output(s) => console::to_stdout(&format!("{s}\n")),
+                    Reply::Error(s) => console::to_stderr(&format!(
+                        "{s}{}",
+                        if s.ends_with('\n') { "" } else { "\n" }
+                    )),
                 }
-                let _ = std::io::stdout().flush();
             }
-            Err(ReadlineError::Interrupted) => println!("(Ctrl-D or :quit leaves)"),
+            Err(ReadlineError::Interrupted) => console::to_stdout("(Ctrl-D or :quit leaves)\n"),
             Err(ReadlineError::Eof) => break,
             Err(e) => {
-                eprintln!("error: {e}");
+                console::to_stderr(&format!("error: {e}\n"));
                 break;
             }
         }

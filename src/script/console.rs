@@ -69,11 +69,7 @@ pub fn note(text: &str) {
     let line = format!("note: {text}\n");
     match NOTE.get() {
         Some(f) => f(&line),
-        None => {
-            let mut err = std::io::stderr().lock();
-            let _ = err.write_all(line.as_bytes());
-            let _ = err.flush();
-        }
+        None => to_stderr(&line),
     }
 }
 
@@ -105,15 +101,48 @@ pub const CLOSED_STDOUT_STATUS: i32 = 141;
 pub fn to_stdout(text: &str) {
     use std::sync::atomic::{AtomicBool, Ordering};
     static TOLD: AtomicBool = AtomicBool::new(false);
-    let mut out = std::io::stdout().lock();
-    if let Err(e) = out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        if e.kind() == std::io::ErrorKind::BrokenPipe {
-            std::process::exit(CLOSED_STDOUT_STATUS);
-        }
+    if let Err(e) = write_stdout(text) {
         if !TOLD.swap(true, Ordering::SeqCst) {
             note(&format!(
                 "cannot write standard output ({e}): what the script prints is lost; check where it is redirected"
             ));
         }
     }
+}
+
+/// Write `text` to standard output for a command whose output is what it makes (`swimlab
+/// reference`, a benchmark's tables, a sweep's lines): as [`to_stdout`] for a reader that went
+/// away; any other failure (a full disk) is the command's error, since its output is lost.
+pub fn emit(text: &str) -> Result<(), String> {
+    write_stdout(text).map_err(|e| {
+        format!(
+            "error: cannot write standard output ({e}): what this command writes is lost; redirect it to a file on a disk with room\n"
+        )
+    })
+}
+
+/// [`emit`] with a newline.
+pub fn emit_line(text: &str) -> Result<(), String> {
+    emit(&format!("{text}\n"))
+}
+
+/// Write `text` to standard error as it is, never failing: a message that cannot be shown has
+/// nowhere else to go (Rust's own `eprint!` would panic).
+pub fn to_stderr(text: &str) {
+    let mut err = std::io::stderr().lock();
+    let _ = err.write_all(text.as_bytes());
+    let _ = err.flush();
+}
+
+/// Standard output written whole and flushed; a closed reader ends the process (see
+/// [`to_stdout`]).
+fn write_stdout(text: &str) -> std::io::Result<()> {
+    let mut out = std::io::stdout().lock();
+    let r = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+    if let Err(e) = &r {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(CLOSED_STDOUT_STATUS);
+        }
+    }
+    r
 }

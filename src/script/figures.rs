@@ -41,7 +41,7 @@ pub fn make_figures(quick: bool, out: Option<&std::path::Path>) -> Result<(), St
     for (name, source) in PAPER_SCRIPTS {
         let start = std::time::Instant::now();
         run_source_with(name, source, &options)?;
-        println!("{name}: {:.1} s", start.elapsed().as_secs_f64());
+        super::console::emit_line(&format!("{name}: {:.1} s", start.elapsed().as_secs_f64()))?;
     }
     if let Some(dir) = out {
         std::fs::create_dir_all(dir).map_err(|e| {
@@ -58,7 +58,7 @@ pub fn make_figures(quick: bool, out: Option<&std::path::Path>) -> Result<(), St
                 let to = dir.join(entry.file_name());
                 std::fs::copy(&path, &to)
                     .map_err(|e| format!("cannot copy to {}: {e}", to.display()))?;
-                println!("copied {}", to.display());
+                super::console::emit_line(&format!("copied {}", to.display()))?;
             }
         }
     }

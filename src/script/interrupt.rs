@@ -28,6 +28,8 @@ pub fn install_batch_handler() {
             std::process::exit(130);
         }
         request();
-        eprintln!("\nswimlab: stopping at the next step boundary (Ctrl-C again quits at once)");
+        super::console::to_stderr(
+            "\nswimlab: stopping at the next step boundary (Ctrl-C again quits at once)\n",
+        );
     });
 }

@@ -125,6 +125,7 @@ fn describe(err: &EvalAltResult) -> Described {
         EvalAltResult::ErrorFunctionNotFound(sig, pos) => plain(*pos, function_not_found(sig)),
         EvalAltResult::ErrorModuleNotFound(m, pos) => plain(*pos, module_not_found(m)),
         EvalAltResult::ErrorDotExpr(msg, pos) => plain(*pos, property_not_found(msg)),
+        EvalAltResult::ErrorDataRace(name, pos) => plain(*pos, data_race(name)),
         EvalAltResult::ErrorDataTooLarge(what, pos) => {
             plain(*pos, super::limits::data_too_large(what))
         }
@@ -279,35 +280,98 @@ fn module_not_found(m: &str) -> String {
     )
 }
 
-/// Rhai's "Unknown property 'foo' - a getter is not registered for type 'Scene'" (and the setter
-/// form) with the closest property of that type.
+/// Rhai's "Data race detected": a variable a closure captured was changed while it was in use,
+/// by calls of the closure that run at once (a sweep's) or by the closure called from inside a
+/// method of that same variable.
+fn data_race(name: &str) -> String {
+    let what = if name.is_empty() {
+        "a variable that a closure captured".to_string()
+    } else {
+        format!("a variable that a closure captured ({name})")
+    };
+    format!(
+        "{what} was changed while it was in use: by calls of the closure that run at once (a sweep's calls share what their closure captures), or by the closure called while a method of that same variable runs; calls may read what they share, not change it: build the value inside the closure, or change a copy there (let t = s.copy(); ...)"
+    )
+}
+
+/// "a Scene", "an int": the type word with its article.
+fn a(ty: &str) -> String {
+    let article = if ty.starts_with(['a', 'e', 'i', 'o', 'u', 'A', 'E', 'I', 'O', 'U']) {
+        "an"
+    } else {
+        "a"
+    };
+    format!("{article} {ty}")
+}
+
+/// Rhai's "Unknown property 'p' - a getter is not registered for type 'T'" and "No writable
+/// property 'p' - a setter is not registered for type 'T' to handle 'U'" in swimlab's words: the
+/// type's properties that can be read (or set), the closest name, and, for a value that has no
+/// such property at all (a number where a scene was meant), the types that do have it.
 fn property_not_found(msg: &str) -> String {
     let quoted: Vec<&str> = msg.split('\'').skip(1).step_by(2).collect();
-    let (Some(prop), Some(ty)) = (quoted.first(), quoted.get(1)) else {
+    let (Some(prop), Some(rhai_ty)) = (quoted.first(), quoted.get(1)) else {
         return msg.to_string();
     };
+    let ty = shown_type(rhai_ty);
     let voc = vocabulary();
     let setter = msg.starts_with("No writable property");
-    let table = if setter { &voc.setters } else { &voc.getters };
-    let Some(props) = table.get(*ty) else {
-        return msg.to_string();
-    };
-    let names: Vec<&str> = props.iter().map(String::as_str).collect();
-    let hint = suggest(prop, &names)
-        .map(|s| format!("did you mean .{s}? "))
-        .unwrap_or_default();
-    let what = if setter { "can be set" } else { "can be read" };
-    let mut text = format!(
-        "{ty} has no property .{prop}; {hint}the properties that {what}: {}",
-        names.join(", ")
-    );
-    if setter
-        && voc
-            .getters
-            .get(*ty)
-            .is_some_and(|g| g.iter().any(|p| p == prop))
-    {
-        text = format!("{ty}.{prop} can be read but not set");
+    let readable = voc.getters.get(&ty);
+    let settable = voc.setters.get(&ty);
+    let list = |props: &[String]| props.join(", ");
+    if setter && readable.is_some_and(|g| g.iter().any(|p| p == prop)) {
+        return match settable {
+            Some(s) => format!(
+                "{ty}.{prop} can be read but not set; the properties of {} that can be set: {}",
+                a(&ty),
+                list(s)
+            ),
+            None => format!(
+                "{ty}.{prop} can be read but not set: no property of {} can be set",
+                a(&ty)
+            ),
+        };
     }
-    text
+    let (table, what) = if setter {
+        (settable, "can be set")
+    } else {
+        (readable, "can be read")
+    };
+    if let Some(props) = table {
+        let names: Vec<&str> = props.iter().map(String::as_str).collect();
+        let hint = suggest(prop, &names)
+            .map(|s| format!("did you mean .{s}? "))
+            .unwrap_or_default();
+        return format!(
+            "{ty} has no property .{prop}; {hint}the properties that {what}: {}",
+            names.join(", ")
+        );
+    }
+    // A type with no property of this kind at all: a plain value, or a read-only type set.
+    let owners: Vec<&str> = voc
+        .getters
+        .iter()
+        .chain(voc.setters.iter())
+        .filter(|(_, props)| props.iter().any(|p| p == prop))
+        .map(|(t, _)| t.as_str())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let none = match (setter, readable) {
+        (true, Some(g)) => format!(
+            "no property of {} can be set (those that can be read: {})",
+            a(&ty),
+            list(g)
+        ),
+        _ => format!("{} has no properties", a(&ty)),
+    };
+    if owners.is_empty() {
+        format!("{ty} has no property .{prop}: {none}")
+    } else {
+        format!(
+            "{ty} has no property .{prop}: {none}; .{prop} is a property of {}: is the value the one you meant? (it is {} here)",
+            owners.join(", "),
+            a(&ty)
+        )
+    }
 }

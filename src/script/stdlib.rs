@@ -41,7 +41,9 @@ fn compile(engine: &Engine) -> StaticModuleResolver {
                 Module::eval_ast_as_new(Scope::new(), &ast, engine).map_err(|e| e.to_string())
             }) {
             Ok(module) => embedded.insert(*name, module),
-            Err(e) => eprintln!("warning: stdlib module \"{name}\" failed to load: {e}"),
+            Err(e) => super::console::to_stderr(&format!(
+                "warning: stdlib module \"{name}\" failed to load: {e}\n"
+            )),
         }
     }
     embedded

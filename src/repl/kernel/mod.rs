@@ -129,7 +129,9 @@ impl Shared {
         Ok(match Message::decode(frames, &self.key) {
             Ok(m) => Some(m),
             Err(why) => {
-                eprintln!("swimlab kernel: dropped a message on the {channel} channel: {why}");
+                console::to_stderr(&format!(
+                    "swimlab kernel: dropped a message on the {channel} channel: {why}\n"
+                ));
                 None
             }
         })
@@ -424,7 +426,9 @@ fn handle_shell(
             json!({"status": "ok", "comms": {}}),
         ),
         "shutdown_request" => shared.shut_down(shell, msg),
-        other => eprintln!("swimlab kernel: no handler for \"{other}\" on the shell channel"),
+        other => console::to_stderr(&format!(
+            "swimlab kernel: no handler for \"{other}\" on the shell channel\n"
+        )),
     }
 }
 
