@@ -2,8 +2,7 @@
 //! of the mirror pair, the symmetries of the pair terms, the exactness of every shortcut, and its
 //! agreement with the microscopic model in the far field.
 
-mod common;
-use common::*;
+use crate::common::*;
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::FRAC_PI_2;
 use swimlab::engine::averaged::{AveragedSystem, Shortcuts};

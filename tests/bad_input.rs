@@ -3,90 +3,19 @@
 //! own `swimlab` process under a time limit, so a hang or an abort fails the test instead of
 //! stalling it, and a panic shows as the "internal error" the script boundary turns it into.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
-
-/// Well above any case's real cost (the slowest reads 256 MiB from /dev/full, ~1 s), far below
-/// what the hangs these cases once were would take.
-const LIMIT: Duration = Duration::from_secs(60);
-
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("swimlab-bad-input-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run `swimlab ARGS` (stdin from `input`) to completion within [`LIMIT`].
-fn swimlab(args: &[&str], input: &str, cwd: &Path) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
-        .args(args)
-        .current_dir(cwd)
-        .env("SWIMLAB_PROGRESS", "0")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start swimlab");
-    let mut stdin = child.stdin.take().unwrap();
-    stdin.write_all(input.as_bytes()).unwrap();
-    drop(stdin);
-    let start = Instant::now();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            return child.wait_with_output().unwrap();
-        }
-        if start.elapsed() > LIMIT {
-            let _ = child.kill();
-            panic!("swimlab {args:?} did not finish within {LIMIT:?} (a hang)");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
+use crate::common::cli::{self, case_dir, swimlab};
+use std::process::Output;
 
 /// Run `script` as a file with `swimlab run`; check the exit code and that stdout+stderr hold
 /// `fragment`, and that no panic surfaced.
 #[track_caller]
 fn case(script: &str, fragment: &str, code: i32) {
-    let d = dir();
-    let file = d.join(format!("case-{}.rhai", fastrand()));
-    std::fs::write(&file, script).unwrap();
-    let out = swimlab(&["run", file.to_str().unwrap()], "", &d);
-    check(script, &out, fragment, code);
+    cli::case(script, &[fragment], code);
 }
 
 #[track_caller]
 fn check(what: &str, out: &Output, fragment: &str, code: i32) {
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(code),
-        "exit code of:\n{what}\n---\n{text}"
-    );
-    assert!(
-        text.contains(fragment),
-        "missing {fragment:?} for:\n{what}\n---\n{text}"
-    );
-    for bad in [
-        "internal error",
-        "panicked",
-        "BackendError",
-        "Function not found",
-    ] {
-        assert!(!text.contains(bad), "{bad:?} for:\n{what}\n---\n{text}");
-    }
-}
-
-/// A unique number per call (file names of cases running in parallel).
-fn fastrand() -> u64 {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static N: AtomicU64 = AtomicU64::new(0);
-    N.fetch_add(1, Ordering::SeqCst)
+    cli::check(what, out, &[fragment], code);
 }
 
 const PAIR: &str = "let s = scene();\ns.add(dumbbell(#{ center: [-25e-6, 0, 0] }));\ns.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 }));\n";
@@ -173,8 +102,8 @@ fn former_hangs_are_refused_with_the_numbers() {
 
 /// A saved scene changed as `edit` says (on the JSON text), then loaded.
 fn bad_scene(edit: impl Fn(&mut serde_json::Value), fragment: &str) {
-    let d = dir();
-    let good = d.join(format!("good-{}.json", fastrand()));
+    let d = case_dir();
+    let good = d.join("good.json");
     let out = swimlab(
         &["-e", &format!("{PAIR}s.save(\"{}\");", good.display())],
         "",
@@ -184,7 +113,7 @@ fn bad_scene(edit: impl Fn(&mut serde_json::Value), fragment: &str) {
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&good).unwrap()).unwrap();
     edit(&mut v);
-    let bad = d.join(format!("bad-{}.json", fastrand()));
+    let bad = d.join("bad.json");
     std::fs::write(&bad, v.to_string()).unwrap();
     let script = format!(
         "let t = load_scene(\"{}\");\nt.run_periods(1);",
@@ -309,7 +238,7 @@ fn messages_name_the_fix() {
 
 #[test]
 fn the_caret_sits_under_the_error_after_tabs_and_wide_characters() {
-    let d = dir();
+    let d = case_dir();
     let file = d.join("caret.rhai");
     std::fs::write(&file, "let x = 1;\n\tlet y = \"é€\"; y.foo();\n").unwrap();
     let out = swimlab(&["run", file.to_str().unwrap()], "", &d);
@@ -331,7 +260,7 @@ fn the_caret_sits_under_the_error_after_tabs_and_wide_characters() {
 
 #[test]
 fn a_byte_order_mark_is_accepted() {
-    let d = dir();
+    let d = case_dir();
     let file = d.join("bom.rhai");
     std::fs::write(&file, "\u{feff}print(40 + 2);\n").unwrap();
     let out = swimlab(&["run", file.to_str().unwrap()], "", &d);
@@ -340,7 +269,7 @@ fn a_byte_order_mark_is_accepted() {
 
 #[test]
 fn piped_errors_go_to_stderr_and_the_session_goes_on() {
-    let out = swimlab(&[], "s.foo;\n1 + 1\n", &dir());
+    let out = swimlab(&[], "s.foo;\n1 + 1\n", &case_dir());
     let (o, e) = (
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr),
@@ -352,7 +281,7 @@ fn piped_errors_go_to_stderr_and_the_session_goes_on() {
 
 #[test]
 fn set_values_are_read_or_refused() {
-    let d = dir();
+    let d = case_dir();
     let file = d.join("sets.rhai");
     std::fs::write(&file, "let D = 4.0;\nprint(D);\n").unwrap();
     let f = file.to_str().unwrap();

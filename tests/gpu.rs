@@ -4,9 +4,8 @@
 //! Without an f64-capable adapter these tests skip with a message, unless SWIMLAB_REQUIRE_GPU=1
 //! (set by .ci/run, which installs lavapipe), where a missing adapter fails them.
 
-mod common;
-
-use common::{about_to_touch, aligned_pair, mirror_inwards, ELL};
+use crate::common;
+use crate::common::{about_to_touch, aligned_pair, mirror_inwards, ELL};
 use nalgebra::Vector3;
 use swimlab::engine::build::{random_suspension, Orientations, Phases};
 use swimlab::engine::error::Setting;

@@ -2,8 +2,7 @@
 //! commutes with stepping, relabelling identical swimmers changes nothing, and the mirror-symmetric
 //! aligned pair keeps its mean separation while it drifts.
 
-mod common;
-use common::*;
+use crate::common::*;
 use nalgebra::{Rotation3, Vector3};
 use std::f64::consts::FRAC_PI_2;
 use swimlab::engine::{Dumbbell, IntegratorSpec, Model, Scene, Simulation};

@@ -5,8 +5,7 @@
 //! (tests/jupyter/run_notebooks.py). Skipped without a Python that has them, unless
 //! `SWIMLAB_REQUIRE_JUPYTER=1` (CI, whose `.ci/run` makes one).
 
-mod common;
-use common::python_with;
+use crate::common::python_with;
 use std::path::Path;
 use std::process::Command;
 

@@ -2,8 +2,7 @@
 //! the pair's separation constant relative to its drift and the state physical; 1e6 periods of the
 //! averaged mirror pair keep |N| = 1 to 1e-12 and the separation exactly.
 
-mod common;
-use common::*;
+use crate::common::*;
 use swimlab::engine::{IntegratorSpec, Model, Simulation};
 
 fn run_long(model: Model, spec: Option<IntegratorSpec>, periods: f64) -> (f64, f64) {

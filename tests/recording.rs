@@ -1,8 +1,7 @@
 //! Recorders take rows exactly at their trigger times and nowhere else; rows survive errors; CSV
 //! carries names and units; a saved scene loads back exactly.
 
-mod common;
-use common::*;
+use crate::common::*;
 use swimlab::engine::{Observable, Recorder, Scene, Simulation, Trigger};
 
 #[test]

@@ -1,8 +1,7 @@
 //! The rigid-stroke limit (k0 → ∞): the spring model converges to it as k0 grows, it obeys the
 //! scallop theorem, and its default integrator meets the drift accuracy budget in far fewer steps.
 
-mod common;
-use common::*;
+use crate::common::*;
 use nalgebra::Vector3;
 use std::f64::consts::FRAC_PI_2;
 use swimlab::engine::{Dumbbell, IntegratorSpec, Model, Scene, Simulation};

@@ -3,8 +3,7 @@
 //! whenever the length does, once per period after the springs settle. Two swimmers in phase (or in
 //! antiphase) are, together, a reciprocal swimmer too: no collective drift.
 
-mod common;
-use common::*;
+use crate::common::*;
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 use swimlab::engine::{Scene, Simulation};

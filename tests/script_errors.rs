@@ -1,8 +1,7 @@
 //! Bad input gets a clear error that names the problem and the fix, at the script position, and
 //! leaves the scene as it was. Nothing panics.
 
-mod common;
-
+use crate::common;
 use rhai::Scope;
 use swimlab::script::run_source;
 

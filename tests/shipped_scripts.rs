@@ -1,7 +1,7 @@
 //! Every shipped script runs through the real binary, and `scripts/pair.rhai` prints the drift the
 //! engine computes.
 
-mod common;
+use crate::common;
 use std::process::Command;
 
 fn swimlab(args: &[&str]) -> (bool, String, String) {

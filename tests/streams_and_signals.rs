@@ -199,7 +199,7 @@ fn a_closed_standard_output_ends_a_piped_session_quietly() {
     // Far more values than a pipe's buffer holds, each shown on its own line.
     std::fs::write(
         &input,
-        "let i = 0;\n".to_string() + &"i += 1; i\n".repeat(200_000),
+        format!("let i = 0;\n{}", "i += 1; i\n".repeat(200_000)),
     )
     .unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))

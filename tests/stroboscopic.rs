@@ -3,8 +3,8 @@
 //! interrupts, guards, periods, saving mid-run, and the tolerance contract against a converged
 //! reference.
 
-mod common;
-use common::*;
+use crate::common;
+use crate::common::*;
 use nalgebra::Vector3;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;

@@ -61,8 +61,11 @@ fn a_local_sweep_runs_every_point_in_its_folder_and_survives_a_failing_one() {
         ],
         &d,
     );
-    let text =
-        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(
         out.status.code(),
         Some(1),

@@ -2,8 +2,7 @@
 //! (so they are deterministic runs of the generator), and each states its false-failure
 //! probability: the chance that a correct implementation, run with another seed, would fail it.
 
-mod common;
-
+use crate::common;
 use nalgebra::{DMatrix, Matrix2, Vector2, Vector3};
 use rayon::prelude::*;
 use swimlab::engine::integrators::{

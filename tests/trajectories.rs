@@ -3,8 +3,8 @@
 //! sharing the recorders' triggers, an XYZ stream and a ParaView series that keep every frame
 //! through `kill -9`, and one writer per file.
 
-mod common;
-use common::python_with;
+use crate::common;
+use crate::common::python_with;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

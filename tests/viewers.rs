@@ -3,8 +3,7 @@
 //! `.ci/run` makes; skipped without one unless `SWIMLAB_REQUIRE_VIEWERS=1`, as in CI), and one
 //! frame rendered headless with OVITO's Tachyon renderer.
 
-mod common;
-use common::python_with;
+use crate::common::python_with;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -3,8 +3,7 @@
 //! body (repulsion, guard, observables); external forces; and the Boltzmann distribution of
 //! Brownian dumbbells sedimenting onto the wall, with and without the drift kT ∇·M.
 
-mod common;
-
+use crate::common;
 use nalgebra::{DMatrix, DVector, Vector3};
 use rayon::prelude::*;
 use std::f64::consts::PI;

@@ -116,6 +116,8 @@ pub fn about_to_touch() -> Scene {
     s
 }
 
+pub mod cli;
+
 /// SplitMix64, the fuzz tests' generator: the same scripts on every machine.
 pub struct Rng(pub u64);
 impl Rng {

@@ -7,36 +7,19 @@
 //! script boundary, where it would show as an "internal error"; no message may show a Rust path
 //! or a Rust debug form. An abort (out of memory) ends this test process, which fails the test.
 //!
-//! The interrupt is process-wide, so this file holds one test and runs its scripts in turn. The
-//! older API has its own fuzz (`tests/fuzz_script_api.rs`).
+//! The older API has its own fuzz (`script_api.rs`); the driver is shared (`driver.rs`).
 
-use std::sync::mpsc;
-use std::time::Duration;
-use swimlab::script::{interrupt, run_source};
-
-mod common;
-use common::Rng;
+use super::driver::{self, Fuzz};
+use crate::common::Rng;
 
 /// Scripts per run: every template is drawn ~60 times, and the run stays well under a minute
 /// (most statements of hostile arguments stop at their first check).
 const SCRIPTS: usize = 800;
 /// Statements per script.
 const STATEMENTS: usize = 7;
-/// A script still running after this is interrupted, as a user would press Ctrl-C...
-const PATIENCE: Duration = Duration::from_secs(3);
-/// ...and must then stop within this: a step of any scene here (six spheres at most, spectral
-/// Ewald included) takes well under a second.
-const STOP_WITHIN: Duration = Duration::from_secs(10);
 /// The seed of the scripts: the same scripts on every machine. `SWIMLAB_FUZZ_SEED` and
 /// `SWIMLAB_FUZZ_SCRIPTS` explore others (a failure names its script, which reruns alone).
 const SEED: u64 = 38_2026;
-
-fn from_env<T: std::str::FromStr>(name: &str, default: T) -> T {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
 
 /// Argument values `V`: ordinary, extreme, of the wrong type, and the newer types.
 const VALUES: &[&str] = &[
@@ -295,41 +278,10 @@ fn script(rng: &mut Rng, paths: &[String]) -> String {
     src.push_str(rng.pick(PROLOGUES));
     src.push_str(COMMON);
     for _ in 0..STATEMENTS {
-        let mut call = rng.pick(CALLS).to_string();
-        // Fill the placeholders left to right; values and paths hold no placeholder letters of
-        // their own that a later search could take (they are looked for in the template only).
-        let mut out = String::new();
-        for c in call.drain(..) {
-            match c {
-                'V' => out.push_str(rng.pick(VALUES)),
-                'P' => out.push_str(rng.pick(&p)),
-                c => out.push(c),
-            }
-        }
+        let out = driver::fill(rng.pick(CALLS), rng, VALUES, &p);
         src.push_str(&format!("try {{ {out}; }} catch (e) {{ print(e); }}\n"));
     }
     src
-}
-
-/// What no message may show: a Rust path or debug form, or Rhai's generated closure names.
-const LEAKS: &[&str] = &[
-    "swimlab::",
-    "Os {",
-    "IoError",
-    "ImageError",
-    "anon$",
-    "alloc::",
-];
-
-/// A printed line that quotes Rust's spelling of a string type. A swimlab function's wrong call
-/// reaches `catch` as its message; an operator's is still Rhai's own error map (Rhai's builtin
-/// operators come after any registered form, so none is registered for them), which may.
-fn rust_spelling(line: &str) -> bool {
-    let operator_map = line
-        .strip_prefix("#{\"error\": \"ErrorFunctionNotFound\", \"function\": \"")
-        .and_then(|rest| rest.split(' ').next())
-        .is_some_and(|f| !f.chars().any(|c| c.is_alphanumeric() || c == '_'));
-    line.contains("ImmutableString") && !operator_map
 }
 
 #[test]
@@ -337,99 +289,14 @@ fn newer_api_scripts_neither_panic_nor_hang_nor_leak_rust_names() {
     let dir = std::env::temp_dir().join(format!("swimlab-fuzz-newer-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    std::env::set_var("SWIMLAB_PROGRESS", "0");
     let paths = paths(&dir.display().to_string());
-    let (seed, scripts) = (
-        from_env("SWIMLAB_FUZZ_SEED", SEED),
-        from_env("SWIMLAB_FUZZ_SCRIPTS", SCRIPTS),
-    );
-    let mut rng = Rng(seed);
-    let mut interrupted = 0;
-    for k in 0..scripts {
-        let src = script(&mut rng, &paths);
-        let (tx, rx) = mpsc::channel();
-        let body = src.clone();
-        std::thread::spawn(move || {
-            // print(e) inside the script goes to this process's stdout; the messages are
-            // checked through a capture of what `print` gets.
-            let printed = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
-            let sink = printed.clone();
-            let mut engine = swimlab::script::engine();
-            engine.on_print(move |s| {
-                if let Ok(mut p) = sink.lock() {
-                    p.push_str(s);
-                    p.push('\n');
-                }
-            });
-            let mut scope = rhai::Scope::new();
-            let result = engine
-                .compile(&body)
-                .map_err(|e| e.to_string())
-                .and_then(|ast| {
-                    engine
-                        .run_ast_with_scope(&mut scope, &ast)
-                        .map_err(|e| e.to_string())
-                });
-            let text = printed.lock().map(|p| p.clone()).unwrap_or_default();
-            // Once in a while the whole script again, through the renderer's path.
-            let rendered = (k % 16 == 0).then(|| {
-                let mut scope = rhai::Scope::new();
-                run_source("fuzz.rhai", &body, &mut scope).err()
-            });
-            let _ = tx.send((result, text, rendered.flatten()));
-        });
-        let (result, printed, rendered) = match rx.recv_timeout(PATIENCE) {
-            Ok(r) => r,
-            Err(_) => {
-                interrupted += 1;
-                // Asked again and again, as a user presses Ctrl-C until it stops: the second,
-                // rendered run clears the request when it starts.
-                let asked = std::time::Instant::now();
-                let r = loop {
-                    interrupt::request();
-                    if let Ok(r) = rx.recv_timeout(Duration::from_millis(100)) {
-                        break r;
-                    }
-                    assert!(
-                        asked.elapsed() < STOP_WITHIN,
-                        "script {k} did not stop within {STOP_WITHIN:?} of an interrupt:\n{src}"
-                    );
-                };
-                interrupt::clear();
-                let calls: Vec<&str> = src.lines().filter(|l| l.starts_with("try")).collect();
-                eprintln!(
-                    "script {k} interrupted after {PATIENCE:?}:\n  {}",
-                    calls.join("\n  ")
-                );
-                r
-            }
-        };
-        let all = format!(
-            "{}\n{printed}",
-            result.as_ref().err().cloned().unwrap_or_default()
-        );
-        assert!(
-            !all.contains("internal error"),
-            "script {k} panicked:\n{src}\n---\n{all}"
-        );
-        for leak in LEAKS {
-            assert!(
-                !printed.contains(leak),
-                "script {k} shows {leak:?}:\n{src}\n---\n{printed}"
-            );
-        }
-        if let Some(line) = printed.lines().find(|l| rust_spelling(l)) {
-            panic!("script {k} shows a Rust type:\n{src}\n---\n{line}");
-        }
-        if let Some(msg) = rendered {
-            assert!(
-                !msg.contains("internal error"),
-                "script {k}:\n{src}\n---\n{msg}"
-            );
-            for leak in LEAKS {
-                assert!(!msg.contains(leak), "script {k} shows {leak:?}:\n{msg}");
-            }
-        }
+    let report = Fuzz {
+        name: "newer API",
+        seed: SEED,
+        scripts: SCRIPTS,
+        captured: true,
+        rendered_every: 16,
     }
-    eprintln!("{scripts} scripts (seed {seed}), {interrupted} interrupted after {PATIENCE:?}");
+    .run(|rng| script(rng, &paths), |_, _, _| {});
+    eprintln!("{report}");
 }

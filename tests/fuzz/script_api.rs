@@ -4,23 +4,15 @@
 //! panic may reach the script boundary, where it would show as an "internal error". An abort
 //! (out of memory) ends this test process, which fails the test too.
 //!
-//! The interrupt is process-wide, so this file holds one test and runs its scripts in turn.
+//! The driver is shared with the other fuzzers (`driver.rs`).
 
-use std::sync::mpsc;
-use std::time::Duration;
-use swimlab::script::{interrupt, run_source};
-
-mod common;
-use common::Rng;
+use super::driver::Fuzz;
+use crate::common::Rng;
 
 /// Scripts per run: enough to touch every template many times (~1 minute of CI time).
 const SCRIPTS: usize = 300;
 /// Statements per script.
 const STATEMENTS: usize = 6;
-/// A script still running after this is interrupted, as a user would press Ctrl-C...
-const PATIENCE: Duration = Duration::from_secs(3);
-/// ...and must then stop within this (a step of any scene here is far below a millisecond).
-const STOP_WITHIN: Duration = Duration::from_secs(10);
 
 /// Argument values: ordinary, extreme, and of the wrong type.
 const VALUES: &[&str] = &[
@@ -194,31 +186,15 @@ fn script(rng: &mut Rng, paths: &[String]) -> String {
 fn no_script_panics_hangs_or_aborts() {
     let dir = std::env::temp_dir().join(format!("swimlab-fuzz-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    std::env::set_var("SWIMLAB_PROGRESS", "0");
     let paths = paths(&dir.display().to_string());
-    let mut rng = Rng(20261201);
-    for k in 0..SCRIPTS {
-        let src = script(&mut rng, &paths);
-        let (tx, rx) = mpsc::channel();
-        let body = src.clone();
-        std::thread::spawn(move || {
-            let mut scope = rhai::Scope::new();
-            let _ = tx.send(run_source("fuzz.rhai", &body, &mut scope));
-        });
-        let result = match rx.recv_timeout(PATIENCE) {
-            Ok(r) => r,
-            Err(_) => {
-                interrupt::request();
-                rx.recv_timeout(STOP_WITHIN).unwrap_or_else(|_| {
-                    panic!("script {k} did not stop within {STOP_WITHIN:?} of an interrupt:\n{src}")
-                })
-            }
-        };
-        if let Err(msg) = &result {
-            assert!(
-                !msg.contains("internal error"),
-                "script {k} panicked:\n{src}\n---\n{msg}"
-            );
-        }
+    // Through the renderer's path alone: these scripts catch every error and print none.
+    let report = Fuzz {
+        name: "script API",
+        seed: 20261201,
+        scripts: SCRIPTS,
+        captured: false,
+        rendered_every: 1,
     }
+    .run(|rng| script(rng, &paths), |_, _, _| {});
+    eprintln!("{report}");
 }

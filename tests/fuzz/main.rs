@@ -1,0 +1,9 @@
+//! The seeded script fuzzers, a binary of their own: a script that runs too long is stopped by
+//! the process-wide interrupt (as Ctrl-C would), which would stop any other test's run in the
+//! same process. They take turns through the driver's lock.
+
+#[path = "../common/mod.rs"]
+mod common;
+mod driver;
+mod newer_api;
+mod script_api;
