@@ -200,13 +200,14 @@ pub fn advance_cpu(
                 break;
             }
             Err(f) => {
+                let problem = s.explain_failure(f.problem);
                 outcome = Err(EngineError::StepFailed {
                     time: f.time,
                     last_good: s.time,
-                    swimmer: f.problem.swimmer,
-                    cause: f.problem.cause,
-                    hint: f.problem.hint,
-                    fixes: f.problem.fixes,
+                    swimmer: problem.swimmer,
+                    cause: problem.cause,
+                    hint: problem.hint,
+                    fixes: problem.fixes,
                 });
                 break;
             }

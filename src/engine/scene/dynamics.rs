@@ -62,8 +62,13 @@ impl Scene {
         (&self.state, &self.base)
     }
 
-    /// The chosen model's right-hand side for the current settings (benchmarks and tests time and probe it).
+    /// The chosen model's right-hand side for the current settings (benchmarks and tests time and
+    /// probe it). A wall beyond the reach of the swimmers now in the scene (set before them, or
+    /// before a smaller one came) is refused here, where every run and rate starts.
     pub fn system(&self) -> Result<Box<dyn OdeSystem>> {
+        if let Some(w) = &self.wall {
+            self.check_wall_reach(w)?;
+        }
         Ok(match self.model {
             Model::Micro => {
                 let mut sys = MicroSystem::new(
@@ -76,6 +81,7 @@ impl Scene {
                 sys.set_thermal(self.thermal);
                 sys.set_mobility(self.mobility_operator()?);
                 sys.set_external(self.sphere_forces());
+                sys.set_reach(self.reach());
                 Box::new(sys)
             }
             Model::Rigid => {
@@ -114,7 +120,37 @@ impl Scene {
         // The constraint solve takes blocks, which are Beenakker's sums.
         sys.set_mobility(self.mobility_operator_by(EwaldMethod::Beenakker)?);
         sys.set_external(self.sphere_forces());
+        sys.set_reach(self.reach());
         Ok(sys)
+    }
+
+    /// What makes the next run far costlier than its length suggests, each as a notice of its
+    /// kind with the fix: spectral Ewald sums chosen for a box of few spheres. Its FFT grid is
+    /// transformed six times a product whatever the number of spheres, while Beenakker's sums
+    /// shrink as N²; below a quarter of the crossover they cost (700/N)² ≳ 16 times less.
+    pub fn cost_notices(&self) -> Vec<(&'static str, EngineError)> {
+        let mut out = Vec::new();
+        let spheres = 2 * self.count();
+        if self.model == Model::Micro
+            && self.ewald_method == EwaldMethod::Spectral
+            && spheres < SPECTRAL_FROM_SPHERES / 4
+        {
+            if let Ok(Some(e)) = self.ewald() {
+                if let Some(g) = e.spectral() {
+                    let [a, b, c] = g.grid();
+                    out.push((
+                        "spectral Ewald",
+                        unsupported(
+                            format!(
+                                "this run will cost far more than its length suggests: spectral Ewald sums transform a {a}x{b}x{c} grid six times for every mobility product, whatever the number of spheres, and with {spheres} spheres Beenakker's sums (O(N^2), faster below {SPECTRAL_FROM_SPHERES} spheres) cost far less"
+                            ),
+                            &[Setting::EwaldMethod("auto"), Setting::EwaldMethod("beenakker")],
+                        ),
+                    ));
+                }
+            }
+        }
+        out
     }
 
     /// The averaged model's cutoff: the one set; in a box at most half its shortest side (a pair
