@@ -259,3 +259,43 @@ fn a_wall_beyond_the_reach_is_refused() {
         1,
     );
 }
+
+/// The integrator in use is checked against the scene as it is at every run: a stepper cached
+/// from an earlier run (built for another model, or without noise) ran on after `s.model` or
+/// `s.temperature` changed, where the same integrator set afresh is refused.
+#[test]
+fn a_changed_scene_rechecks_its_integrator() {
+    let box_of = "let s = scene();\ns.box = [100e-6, 100e-6, 100e-6];\ns.add_random(dumbbell(), 80, 1);\ns.model = \"averaged\";\n";
+    case(
+        &format!("{box_of}s.integrator = suspension(1e-3);\ns.run_periods(1);\ns.model = \"micro\";\nlet t = s.time;\ntry {{ s.run(1e-4); }} catch (e) {{ print(e); }}\nprint(s.time == t);"),
+        &[
+            "suspension(1e-3) is the averaged model's method for suspensions: the micro model's springs",
+            "true",
+        ],
+        &[],
+        0,
+    );
+    // The default re-makes its choice for the new model: auto for the spring model.
+    case(
+        &format!(
+            "{box_of}s.run_periods(1);\ns.model = \"micro\";\ns.run(1e-4);\nprint(s.integrator);"
+        ),
+        &["auto(1.1e-5)"],
+        &[],
+        0,
+    );
+    case(
+        &format!(
+            "{ONE}s.integrator = dopri5(1e-6);\ns.run(1e-4);\ns.temperature = 300;\ns.run(1e-4);"
+        ),
+        &["dopri5(1e-6) is a deterministic method and cannot carry thermal noise"],
+        &[],
+        1,
+    );
+    case(
+        &format!("{ONE}s.temperature = 300;\ns.integrator = euler(1e-6);\ns.run(1e-5);\ns.model = \"rigid\";\ns.run(1e-5);"),
+        &["thermal noise (temperature 300 K) is not available in the rigid-stroke model"],
+        &[],
+        1,
+    );
+}

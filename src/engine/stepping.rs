@@ -142,13 +142,15 @@ impl Workspace {
     }
 
     /// The cached stepper, reset, if it was built for `spec` and the scene key `key`; else a new
-    /// one for the scene.
+    /// one for the scene. Either way `spec` must suit the scene as it is now (a cached stepper
+    /// was built for the scene as it was: another model, no noise).
     fn take_stepper(
         &mut self,
         s: &Scene,
         spec: IntegratorSpec,
         key: &[u64],
     ) -> Result<Box<dyn Stepper>> {
+        s.check_integrator(spec)?;
         match self.stepper.take() {
             Some((cached, cached_key, mut st)) if cached == spec && cached_key == key => {
                 st.reset();

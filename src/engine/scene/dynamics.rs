@@ -229,8 +229,9 @@ const RELAXED_E_FOLDINGS: f64 = 37.0;
 
 impl Scene {
     /// What a stepper for `spec` was built from besides the spec: a cached one is reused only
-    /// while this stays. Direct methods take nothing from the scene; stroboscopic averaging and
-    /// `auto` take the swimmers' count, the model, μ, the common period and the RK4 step.
+    /// while this stays (and [`Scene::check_integrator`] passes). Direct methods take nothing
+    /// from the scene; stroboscopic averaging and `auto` take the swimmers' count, the model, μ,
+    /// the common period, the RK4 step and whether the scene is a suspension (`auto`'s choice).
     pub(crate) fn stepper_key(&self, spec: IntegratorSpec) -> Vec<u64> {
         match spec {
             IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => vec![
@@ -239,6 +240,7 @@ impl Scene {
                 self.mu.to_bits(),
                 self.common_period().map_or(0, f64::to_bits),
                 self.default_micro_step().to_bits(),
+                u64::from(self.is_suspension()),
             ],
             _ => Vec::new(),
         }
@@ -248,7 +250,7 @@ impl Scene {
     /// the slowest spring relaxation (how many periods settle the springs after a start) and a
     /// length scale.
     pub(crate) fn stepper(&self, spec: IntegratorSpec) -> Result<Box<dyn Stepper>> {
-        self.check_noise(spec)?;
+        self.check_integrator(spec)?;
         if let Some(st) = spec.build() {
             return Ok(st);
         }
@@ -256,24 +258,12 @@ impl Scene {
             return self.stepper(self.auto_choice(tol)?.0);
         }
         if let IntegratorSpec::Suspension { tol } = spec {
-            if self.model != Model::Averaged {
-                return Err(unsupported(
-                    format!("{spec} is the averaged model's method for suspensions: the {} model's springs or strokes have no steric-contact structure for it to use", self.model.name()),
-                    &[Setting::Model("averaged"), Setting::DefaultIntegrator],
-                ));
-            }
             // The first step: one stroke period (the controller takes it from there).
             return Ok(Box::new(Suspension::new(tol, self.shortest_period())));
         }
         let IntegratorSpec::Stroboscopic { tol, inner } = spec else {
             return Err(invalid!("{spec} has no stepper"));
         };
-        if self.model == Model::Averaged {
-            return Err(unsupported(
-                "stroboscopic averaging is for the spring and rigid-stroke models: the averaged model is averaged already",
-                &[Setting::Model("micro"), Setting::Model("rigid"), Setting::DefaultIntegrator],
-            ));
-        }
         let period = self.common_period()?;
         let inner = inner
             .map(IntegratorSpec::from)
@@ -305,6 +295,25 @@ impl Scene {
             transient,
             length,
         )))
+    }
+
+    /// What refuses integrator `spec` on the scene as it is now: thermal noise's refusals,
+    /// `suspension` outside the averaged model, stroboscopic averaging inside it. Every run asks,
+    /// a cached stepper's too: the model, the temperature or the swimmers may have changed since
+    /// it was built.
+    pub(crate) fn check_integrator(&self, spec: IntegratorSpec) -> Result<()> {
+        self.check_noise(spec)?;
+        match spec {
+            IntegratorSpec::Suspension { .. } if self.model != Model::Averaged => Err(unsupported(
+                format!("{spec} is the averaged model's method for suspensions: the {} model's springs or strokes have no steric-contact structure for it to use", self.model.name()),
+                &[Setting::Model("averaged"), Setting::DefaultIntegrator],
+            )),
+            IntegratorSpec::Stroboscopic { .. } if self.model == Model::Averaged => Err(unsupported(
+                "stroboscopic averaging is for the spring and rigid-stroke models: the averaged model is averaged already",
+                &[Setting::Model("micro"), Setting::Model("rigid"), Setting::DefaultIntegrator],
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// What thermal noise refuses: the rigid-stroke model, deterministic integrators, and Platen's
