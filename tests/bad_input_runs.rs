@@ -299,3 +299,44 @@ fn a_changed_scene_rechecks_its_integrator() {
         1,
     );
 }
+
+/// 500 averaged swimmers in a box of 20ℓ took ~70 times as long a period under the box's default
+/// cutoff L/2 as just below it: at L/2 the neighbour lists have no skin, and every right-hand
+/// side rebuilt them. The default keeps the skin; a cutoff set to L/2 says so when a run starts.
+#[test]
+fn the_default_cutoff_of_a_box_keeps_the_lists_skin() {
+    use swimlab::engine::averaged::DEFAULT_SKIN_OF_CUTOFF;
+    use swimlab::engine::neighbours::ListSpec;
+    use swimlab::engine::{Dumbbell, Model, Scene};
+    let l = 100e-6;
+    let mut s = Scene::new();
+    s.set_model(Model::Averaged);
+    s.set_box(Some([l; 3])).unwrap();
+    s.add(
+        Dumbbell::default(),
+        nalgebra::Vector3::zeros(),
+        nalgebra::Vector3::x(),
+    )
+    .unwrap();
+    let c = s.averaged_cutoff().unwrap().unwrap();
+    let wanted = DEFAULT_SKIN_OF_CUTOFF * c;
+    let b = s.periodic().copied();
+    // The skin the lists get is the one they want, to the rounding of c·(1 + skin) against L/2.
+    let skin = ListSpec::fitted_skin(c, 0.0, wanted, b.as_ref());
+    assert!((skin - wanted).abs() <= 1e-12 * c, "{skin} of {wanted}");
+    let scene = "let s = scene();\ns.box = [100e-6, 100e-6, 100e-6];\ns.add_random(dumbbell(), 300, 1);\ns.model = \"averaged\";\n";
+    let t = case(
+        &format!("{scene}s.cutoff = 50e-6;\ns.run(1e-6);\ns.run(1e-6);"),
+        &[
+            "note: this run will cost far more than its length suggests: the cutoff 5e-5 m reaches half the box's shortest side",
+            "no skin",
+            "the box's default cutoff, 4.7619e-5 m",
+            "s.cutoff = ()",
+        ],
+        &[],
+        0,
+    );
+    assert_eq!(t.matches("note:").count(), 2, "once a run: {t}");
+    let t = case(&format!("{scene}s.run(1e-6);"), &[], &["note:"], 0);
+    assert!(t.is_empty(), "{t}");
+}

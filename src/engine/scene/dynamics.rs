@@ -2,6 +2,7 @@
 //! the right-hand side ([`OdeSystem`]) of the chosen model that every run and query uses.
 
 use super::*;
+use crate::engine::averaged::DEFAULT_SKIN_OF_CUTOFF;
 use crate::engine::integrators::{Stepper, Stroboscopic, Suspension, MIN_MACRO};
 
 impl Scene {
@@ -125,11 +126,30 @@ impl Scene {
     }
 
     /// What makes the next run far costlier than its length suggests, each as a notice of its
-    /// kind with the fix: spectral Ewald sums chosen for a box of few spheres. Its FFT grid is
+    /// kind with the fix: spectral Ewald sums chosen for a box of few spheres (its FFT grid is
     /// transformed six times a product whatever the number of spheres, while Beenakker's sums
-    /// shrink as N²; below a quarter of the crossover they cost (700/N)² ≳ 16 times less.
+    /// shrink as N²; below a quarter of the crossover they cost (700/N)² ≳ 16 times less); an
+    /// averaged suspension's cutoff set to half the box, which leaves its neighbour lists no
+    /// skin (every right-hand side rebuilds them).
     pub fn cost_notices(&self) -> Vec<(&'static str, EngineError)> {
         let mut out = Vec::new();
+        if let (Model::Averaged, Some(b), Some(c)) = (self.model, &self.periodic, self.cutoff) {
+            let half = 0.5 * b.shortest();
+            if self.count() >= crate::engine::averaged::LIST_SWIMMERS && c >= half {
+                out.push((
+                    "cutoff without skin",
+                    unsupported(
+                        format!(
+                            "this run will cost far more than its length suggests: the cutoff {c:e} m reaches half the box's shortest side, which leaves the neighbour lists of its {} swimmers no skin (pairs within the cutoff plus {:.0}% of it must meet one image), so every right-hand side rebuilds them; the box's default cutoff, {:.4e} m, keeps the skin, and the pairs it leaves out change the rates by far less than a suspension's tolerance",
+                            self.count(),
+                            100.0 * DEFAULT_SKIN_OF_CUTOFF,
+                            half / (1.0 + DEFAULT_SKIN_OF_CUTOFF)
+                        ),
+                        &[Setting::NoCutoff],
+                    ),
+                ));
+            }
+        }
         let spheres = 2 * self.count();
         if self.model == Model::Micro
             && self.ewald_method == EwaldMethod::Spectral
@@ -154,14 +174,18 @@ impl Scene {
     }
 
     /// The averaged model's cutoff: the one set; in a box at most half its shortest side (a pair
-    /// meets one image), and half that side when none is set.
+    /// meets one image), and when none is set the longest that leaves the neighbour lists their
+    /// skin within that half, L/2 / (1 + [`DEFAULT_SKIN_OF_CUTOFF`]) = 0.476 L. At L/2 itself
+    /// the lists would have no skin and every right-hand side would rebuild them, tens of times
+    /// the cost, for pair terms that change the rates by far less than a suspension's tolerance
+    /// (the measurements are in the book's "Suspensions, boxes and fields").
     pub fn averaged_cutoff(&self) -> Result<Option<f64>> {
         let Some(b) = &self.periodic else {
             return Ok(self.cutoff);
         };
         let half = 0.5 * b.shortest();
         match self.cutoff {
-            None => Ok(Some(half)),
+            None => Ok(Some(half / (1.0 + DEFAULT_SKIN_OF_CUTOFF))),
             Some(c) if c <= half => Ok(Some(c)),
             Some(c) => Err(invalid!(
                 "the averaged model's cutoff {c:e} m is longer than half the box's shortest side ({half:e} m): a pair would meet two images; set the cutoff to {half:e} m or less, or use a larger box"
