@@ -262,8 +262,9 @@ fn pairs_across_a_face_meet_by_their_minimum_image() {
     }
 }
 
-/// The averaged model in a box: the cutoff defaults to L/2, a longer one is refused with the fix;
-/// the GPU refuses a box and names the CPU.
+/// The averaged model in a box: the cutoff defaults to the longest that leaves the neighbour
+/// lists their skin within L/2, a longer one than L/2 is refused with the fix; the GPU refuses a
+/// box and names the CPU.
 #[test]
 fn a_box_limits_the_cutoff_and_stays_on_the_cpu() {
     let d = Dumbbell::default();
@@ -272,7 +273,8 @@ fn a_box_limits_the_cutoff_and_stays_on_the_cpu() {
     s.set_model(Model::Averaged);
     s.set_box(Some([l; 3])).unwrap();
     s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
-    assert_eq!(s.averaged_cutoff().unwrap(), Some(0.5 * l));
+    let skin = swimlab::engine::averaged::DEFAULT_SKIN_OF_CUTOFF;
+    assert_eq!(s.averaged_cutoff().unwrap(), Some(0.5 * l / (1.0 + skin)));
     s.set_cutoff(Some(0.6 * l)).unwrap();
     let e = s.averaged_cutoff().unwrap_err().to_string();
     assert!(e.contains("half the box") && e.contains("cutoff to"), "{e}");

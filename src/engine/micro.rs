@@ -8,7 +8,7 @@
 //! - db/dt = −f (1/γ₁ + 1/γ₂) + u₂ − u₁, γ = 6πμa.
 
 use super::contacts::Contacts;
-use super::integrators::{Noise, OdeSystem, Problem};
+use super::integrators::{Noise, OdeSystem, Problem, Reach};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use super::spheres::Spheres;
@@ -30,6 +30,8 @@ pub struct MicroSystem {
     /// end and the next one's start), and the sine is a sizeable part of a small scene's rates.
     rest: Vec<f64>,
     rest_t: f64,
+    /// How far the centres may go (unbounded until set).
+    reach: Reach,
 }
 
 impl MicroSystem {
@@ -49,7 +51,13 @@ impl MicroSystem {
             kicks: Vec::new(),
             rest: swimmers.iter().map(|d| d.rest_length(0.0)).collect(),
             rest_t: 0.0,
+            reach: Reach::default(),
         }
+    }
+
+    /// Hold the centres within `reach`: a step beyond it fails.
+    pub fn set_reach(&mut self, reach: Reach) {
+        self.reach = reach;
     }
 
     /// Bring the rest lengths to time `t`.
@@ -284,10 +292,24 @@ impl OdeSystem for MicroSystem {
         Ok(())
     }
 
-    /// Rejects overlapping spheres, and springs stretched or compressed by more than half a body
-    /// length beyond their rest length: a stiff spring follows L(t) within ~λω/rate ≈ 1e-3 λ, so
-    /// such a deviation is a numerical instability (explicit steps above the stability limit grow
-    /// the spring mode geometrically), never physics.
+    /// The shortest stroke period (0 without swimmers: no scale).
+    fn time_scale(&self) -> f64 {
+        let t = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(f64::INFINITY, f64::min);
+        if t.is_finite() {
+            t
+        } else {
+            0.0
+        }
+    }
+
+    /// Rejects overlapping spheres, centres beyond the reach, and springs stretched or compressed
+    /// by more than half a body length beyond their rest length: a stiff spring follows L(t)
+    /// within ~λω/rate ≈ 1e-3 λ, so such a deviation is a numerical instability (explicit steps
+    /// above the stability limit grow the spring mode geometrically), never physics.
     fn check(&mut self, t: f64, y: &[f64]) -> Result<(), Problem> {
         self.rest_at(t);
         for (s, d) in self.swimmers.iter().enumerate() {
@@ -308,6 +330,9 @@ impl OdeSystem for MicroSystem {
                     fixes: vec![crate::engine::error::Setting::DefaultIntegrator],
                 });
             }
+        }
+        for (s, b) in self.base.iter().enumerate() {
+            self.reach.check(s, &(b + vec3(y, STATE_PER_SWIMMER * s)))?;
         }
         self.place(y);
         match self.spheres.first_overlap() {

@@ -13,7 +13,7 @@
 //! step is set by the stroke, not by the spring.
 
 use super::contacts::Contacts;
-use super::integrators::{OdeSystem, Problem};
+use super::integrators::{OdeSystem, Problem, Reach};
 use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use super::spheres::Spheres;
@@ -30,6 +30,8 @@ pub struct RigidSystem {
     rate: DVector<f64>,
     /// Scratch: the sphere velocities of the body forces alone.
     body: Vec<Vector3<f64>>,
+    /// How far the centres may go (unbounded until set).
+    reach: Reach,
 }
 
 impl RigidSystem {
@@ -56,7 +58,13 @@ impl RigidSystem {
             a: DMatrix::zeros(s, s),
             rate: DVector::zeros(s),
             body: Vec::new(),
+            reach: Reach::default(),
         }
+    }
+
+    /// Hold the centres within `reach`: a step beyond it fails.
+    pub fn set_reach(&mut self, reach: Reach) {
+        self.reach = reach;
     }
 
     fn place(&mut self, t: f64, y: &[f64]) {
@@ -152,7 +160,25 @@ impl OdeSystem for RigidSystem {
         }
     }
 
+    /// The shortest stroke period (0 without swimmers: no scale).
+    fn time_scale(&self) -> f64 {
+        let t = self
+            .swimmers
+            .iter()
+            .map(Dumbbell::period)
+            .fold(f64::INFINITY, f64::min);
+        if t.is_finite() {
+            t
+        } else {
+            0.0
+        }
+    }
+
+    /// Rejects centres beyond the reach and overlapping spheres.
     fn check(&mut self, t: f64, y: &[f64]) -> Result<(), Problem> {
+        for (s, b) in self.base.iter().enumerate() {
+            self.reach.check(s, &(b + vec3(y, STATE_PER_SWIMMER * s)))?;
+        }
         self.place(t, y);
         match self.spheres.first_overlap() {
             Some(p) => Err(p),

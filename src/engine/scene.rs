@@ -4,8 +4,9 @@
 //!
 //! This file holds the state, its configuration and plain reading; the rest of `Scene` lives in
 //! child modules: `placement` (adding swimmers and the checks they pass), `timing` (periods and
-//! the integrator, set or default), `dynamics` (the models' right-hand side and what it says now)
-//! and `save` (JSON, and validation on load).
+//! the integrator, set or default), `dynamics` (the models' right-hand side, what it says now and
+//! what the next run costs), `external` (the wall and external forces, and the reach positions and
+//! the wall are held to) and `save` (JSON, and validation on load).
 
 use super::averaged::AveragedSystem;
 use super::backend::Backend;
@@ -15,7 +16,7 @@ use super::error::{
 };
 use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_FROM_SPHERES};
 use super::forces::{ExternalForces, Gravity};
-use super::integrators::{IntegratorSpec, OdeSystem, Stats};
+use super::integrators::{IntegratorSpec, OdeSystem, Reach, Stats};
 use super::micro::MicroSystem;
 use super::mobility::{Mobility, MobilityOperator};
 use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
@@ -29,6 +30,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 mod dynamics;
+mod external;
 mod placement;
 mod save;
 mod timing;
@@ -328,73 +330,6 @@ impl Scene {
         Ok(())
     }
 
-    /// The no-slip wall, if any.
-    pub fn wall(&self) -> Option<&Wall> {
-        self.wall.as_ref()
-    }
-
-    /// Put a no-slip wall below the fluid, or (`None`) take it away. Every sphere must lie clear
-    /// above it, and a periodic box is refused (no images of the wall); otherwise the scene is
-    /// unchanged and the error says which.
-    pub fn set_wall(&mut self, wall: Option<Wall>) -> Result<()> {
-        let Some(w) = wall else {
-            self.wall = None;
-            return Ok(());
-        };
-        let w = w.checked()?;
-        if self.periodic.is_some() {
-            return Err(unsupported(
-                "a wall in a periodic box is not available (the wall's mobility has no periodic images); leave the box first",
-                &[Setting::NoBox],
-            ));
-        }
-        self.check_above(&w)?;
-        self.wall = Some(w);
-        Ok(())
-    }
-
-    /// Every sphere clear above wall `w`, or the error naming the first that is not.
-    pub(in crate::engine) fn check_above(&self, w: &Wall) -> Result<()> {
-        for i in 0..self.count() {
-            let (x1, x2) = self.spheres(i);
-            let d = &self.swimmers[i];
-            for (k, (x, a)) in [(x1, d.a1), (x2, d.a2)].into_iter().enumerate() {
-                let gap = w.gap(&x, a);
-                if gap <= 0.0 {
-                    return Err(invalid!(
-                        "sphere {} of swimmer {i} is not above the wall at z = {:e} m (its gap is {gap:.3e} m); move the swimmers up or put the wall lower",
-                        k + 1,
-                        w.z
-                    ));
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// The external forces on the spheres.
-    pub fn external(&self) -> ExternalForces {
-        self.external
-    }
-
-    /// Put the same force `force` (N) on every sphere ([0, 0, 0]: none).
-    pub fn set_external_force(&mut self, force: [f64; 3]) -> Result<()> {
-        self.external.force = ExternalForces::check_force(force)?;
-        Ok(())
-    }
-
-    /// Gravity with buoyancy on the spheres, or (`None`) none.
-    pub fn set_gravity(&mut self, gravity: Option<Gravity>) -> Result<()> {
-        self.external.gravity = gravity.map(Gravity::checked).transpose()?;
-        Ok(())
-    }
-
-    /// The external force on every sphere in sphere order (empty when there is none).
-    pub(crate) fn sphere_forces(&self) -> Vec<Vector3<f64>> {
-        self.external
-            .per_sphere(self.swimmers.iter().flat_map(|d| [d.a1, d.a2]))
-    }
-
     /// Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility.
     pub fn ewald_tol(&self) -> f64 {
         self.ewald_tol
@@ -415,35 +350,6 @@ impl Scene {
     /// Set how the box's mobility products are summed.
     pub fn set_ewald_method(&mut self, method: EwaldMethod) {
         self.ewald_method = method;
-    }
-
-    /// What makes the next run far costlier than its length suggests, each as a notice of its
-    /// kind with the fix: spectral Ewald sums chosen for a box of few spheres. Its FFT grid is
-    /// transformed six times a product whatever the number of spheres, while Beenakker's sums
-    /// shrink as N²; below a quarter of the crossover they cost (700/N)² ≳ 16 times less.
-    pub fn cost_notices(&self) -> Vec<(&'static str, EngineError)> {
-        let mut out = Vec::new();
-        let spheres = 2 * self.count();
-        if self.model == Model::Micro
-            && self.ewald_method == EwaldMethod::Spectral
-            && spheres < SPECTRAL_FROM_SPHERES / 4
-        {
-            if let Ok(Some(e)) = self.ewald() {
-                if let Some(g) = e.spectral() {
-                    let [a, b, c] = g.grid();
-                    out.push((
-                        "spectral Ewald",
-                        unsupported(
-                            format!(
-                                "this run will cost far more than its length suggests: spectral Ewald sums transform a {a}x{b}x{c} grid six times for every mobility product, whatever the number of spheres, and with {spheres} spheres Beenakker's sums (O(N^2), faster below {SPECTRAL_FROM_SPHERES} spheres) cost far less"
-                            ),
-                            &[Setting::EwaldMethod("auto"), Setting::EwaldMethod("beenakker")],
-                        ),
-                    ));
-                }
-            }
-        }
-        out
     }
 
     /// The box's periodic mobility for the sphere models (`None` in open space), its products by
@@ -541,14 +447,6 @@ impl Scene {
         let old = self.swimmers[i].phase;
         self.swimmers[i].phase = phase;
         self.keep_above_wall(|s| s.swimmers[i].phase = old)
-    }
-
-    /// Undo a change with `undo` if it left a sphere at or below the wall, and say which.
-    fn keep_above_wall(&mut self, undo: impl FnOnce(&mut Self)) -> Result<()> {
-        let Some(w) = self.wall else {
-            return Ok(());
-        };
-        self.check_above(&w).inspect_err(|_| undo(self))
     }
 
     /// All stroke phases φ (rad), in swimmer order.

@@ -142,13 +142,15 @@ impl Workspace {
     }
 
     /// The cached stepper, reset, if it was built for `spec` and the scene key `key`; else a new
-    /// one for the scene.
+    /// one for the scene. Either way `spec` must suit the scene as it is now (a cached stepper
+    /// was built for the scene as it was: another model, no noise).
     fn take_stepper(
         &mut self,
         s: &Scene,
         spec: IntegratorSpec,
         key: &[u64],
     ) -> Result<Box<dyn Stepper>> {
+        s.check_integrator(spec)?;
         match self.stepper.take() {
             Some((cached, cached_key, mut st)) if cached == spec && cached_key == key => {
                 st.reset();
@@ -200,13 +202,14 @@ pub fn advance_cpu(
                 break;
             }
             Err(f) => {
+                let problem = s.explain_failure(f.problem);
                 outcome = Err(EngineError::StepFailed {
                     time: f.time,
                     last_good: s.time,
-                    swimmer: f.problem.swimmer,
-                    cause: f.problem.cause,
-                    hint: f.problem.hint,
-                    fixes: f.problem.fixes,
+                    swimmer: problem.swimmer,
+                    cause: problem.cause,
+                    hint: problem.hint,
+                    fixes: problem.fixes,
                 });
                 break;
             }

@@ -152,6 +152,9 @@ pub struct AveragedSystem {
     thermal: Option<(u64, Vec<RigidDiffusion>)>,
     /// The periodic box, if any: pairs by minimum image (the scene requires a cutoff ≤ L/2).
     periodic: Option<PeriodicBox>,
+    /// The shortest stroke period (s; infinite without swimmers): the time scale adaptive steps
+    /// are held to.
+    period: f64,
 }
 
 /// From this many swimmers the all-pairs rows are summed in vector lanes ([`lanes`]); below it
@@ -225,6 +228,10 @@ impl AveragedSystem {
             lanes: None,
             thermal: None,
             periodic: None,
+            period: swimmers
+                .iter()
+                .map(Dumbbell::period)
+                .fold(f64::INFINITY, f64::min),
         };
         if shortcuts.aligned_1d {
             sys.axis = sys.common_axis(y);

@@ -46,6 +46,14 @@ impl OdeSystem for AveragedSystem {
         true
     }
 
+    fn time_scale(&self) -> f64 {
+        if self.period.is_finite() {
+            self.period
+        } else {
+            0.0
+        }
+    }
+
     fn stiff_groups(&mut self, _t: f64, y: &[f64]) -> GroupJacobian {
         self.contact_jacobian(y)
     }

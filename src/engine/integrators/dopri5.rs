@@ -197,6 +197,7 @@ impl Stepper for Dopri5 {
         };
         let mut rejected_last = false;
         let mut rejects = 0;
+        let scale = sys.time_scale();
         loop {
             let span = t_end - t;
             let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
@@ -231,6 +232,15 @@ impl Stepper for Dopri5 {
                     if rejected_last {
                         h_next = h_next.min(h_try);
                     }
+                    // A step below the floor that the error estimate does not let grow never
+                    // gets anywhere (a start from a tiny step grows up to 10× a step instead).
+                    if self.fixed.is_none()
+                        && !last
+                        && h_next <= h_try
+                        && step_too_small(h_next, t, scale)
+                    {
+                        return Err(stalled(t_new, h_next, t, scale));
+                    }
                     self.fac_old = err_norm.max(1e-4);
                     // A step clipped to land on t_end says nothing about the natural step size.
                     self.h = Some(if last && h_try < h {
@@ -254,7 +264,7 @@ impl Stepper for Dopri5 {
                     h = h_try * 0.25;
                     // Crawling towards the event the guard refuses (spheres about to touch):
                     // stop with it once the step no longer advances the time.
-                    if step_too_small(h, t) {
+                    if step_too_small(h, t, scale) {
                         self.h = Some(h_try);
                         return Err(failure);
                     }
@@ -271,8 +281,8 @@ impl Stepper for Dopri5 {
                         1.0 / FAC_MIN
                     };
                     h = h_try / shrink;
-                    if step_too_small(h, t) {
-                        return Err(stalled(t_new, h));
+                    if step_too_small(h, t, scale) {
+                        return Err(stalled(t_new, h, t, scale));
                     }
                 }
             }

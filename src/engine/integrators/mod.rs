@@ -31,5 +31,5 @@ pub use stroboscopic::{Stroboscopic, MIN_MACRO};
 pub use suspension::Suspension;
 pub use system::{
     require_resolvable, uniform_steps, GroupJacobian, Interrupt, Noise, OdeSystem, Partitioned,
-    Problem, Stats, StepFailure, Stepper, MIN_RELATIVE_INTERVAL,
+    Problem, Reach, Stats, StepFailure, Stepper, MIN_RELATIVE_INTERVAL,
 };

@@ -231,6 +231,7 @@ impl Stepper for Rosenbrock {
             (None, None) => (t_end - t).min(1e-3 * (t_end - t).max(1e-9)),
         };
         let mut rejects = 0;
+        let scale = sys.time_scale();
         loop {
             let span = t_end - t;
             let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
@@ -262,9 +263,18 @@ impl Stepper for Rosenbrock {
             };
             match (accept, guard) {
                 (true, Ok(())) => {
+                    let h_next = h_try * fac;
+                    // A step below the floor that the error estimate does not let grow never
+                    // gets anywhere (a start from a tiny step grows up to 5× a step instead).
+                    if self.fixed.is_none()
+                        && !last
+                        && h_next <= h_try
+                        && step_too_small(h_next, t, scale)
+                    {
+                        return Err(stalled(t_new, h_next, t, scale));
+                    }
                     y.copy_from_slice(&self.y_new);
                     stats.steps += 1;
-                    let h_next = h_try * fac;
                     self.h = Some(if last && h_try < h {
                         h.max(h_next)
                     } else {
@@ -282,7 +292,7 @@ impl Stepper for Rosenbrock {
                     h = h_try * 0.25;
                     // Crawling towards the event the guard refuses (spheres about to touch):
                     // stop with it once the step no longer advances the time.
-                    if step_too_small(h, t) {
+                    if step_too_small(h, t, scale) {
                         self.h = Some(h_try);
                         return Err(failure);
                     }
@@ -294,8 +304,8 @@ impl Stepper for Rosenbrock {
                         return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
                     }
                     h = h_try * fac.min(0.9);
-                    if step_too_small(h, t) {
-                        return Err(stalled(t_new, h));
+                    if step_too_small(h, t, scale) {
+                        return Err(stalled(t_new, h, t, scale));
                     }
                 }
             }

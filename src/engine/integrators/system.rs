@@ -1,7 +1,7 @@
 //! The contract between models and integrators.
 
 use crate::engine::error::{invalid, Setting};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// A first-order system dy/dt = f(t, y) with the hooks the integrators need.
@@ -13,6 +13,13 @@ pub trait OdeSystem {
     /// Absolute size of each component that a relative tolerance refers to: an adaptive step is
     /// accepted when |error_i| ≲ rtol · scale_i.
     fn error_scale(&self, y: &[f64], scale: &mut [f64]);
+    /// The time the dynamics unfold on (s): the shortest stroke period for the swimmer models.
+    /// An adaptive step below [`MIN_RELATIVE_INTERVAL`] of it (or of t, whichever is longer)
+    /// stops the run ([`step_too_small`]): one such period would take more than 1e12 steps. 0
+    /// (the default): steps are held to t alone.
+    fn time_scale(&self) -> f64 {
+        0.0
+    }
     /// Check a freshly computed state (NaN, overlap, ...). `Err` rejects the step.
     fn check(&mut self, _t: f64, _y: &[f64]) -> Result<(), Problem> {
         Ok(())
@@ -257,6 +264,47 @@ pub struct Problem {
     pub fixes: Vec<crate::engine::error::Setting>,
 }
 
+/// How far from the origin a swimmer's centre may go (m, in each coordinate), for the guard the
+/// swimmer models apply in [`OdeSystem::check`]: a step that takes a centre beyond it fails like
+/// any other failed step. The scene sets it, with the words that say why it lies there (where
+/// f64 stops resolving the spheres); unbounded by default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reach {
+    /// The largest |coordinate| of a centre (m).
+    pub limit: f64,
+    /// Why the limit lies there, in words for the message.
+    pub why: String,
+}
+
+impl Default for Reach {
+    fn default() -> Self {
+        Reach {
+            limit: f64::INFINITY,
+            why: String::new(),
+        }
+    }
+}
+
+impl Reach {
+    /// Swimmer `s`'s centre `c` within the limit, or the problem naming the coordinate beyond it.
+    pub fn check(&self, s: usize, c: &Vector3<f64>) -> Result<(), Problem> {
+        for (k, x) in ["x", "y", "z"].iter().zip(c.iter()) {
+            if x.abs() > self.limit {
+                return Err(Problem {
+                    swimmer: Some(s),
+                    cause: format!(
+                        "the centre of swimmer {s} reached {k} = {x:e} m, beyond the {:e} m from the origin that positions may reach ({})",
+                        self.limit, self.why
+                    ),
+                    hint: "start the swimmers nearer the origin, or run a shorter time".into(),
+                    fixes: Vec::new(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 /// A step that could not be completed; the caller's state is unchanged.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepFailure {
@@ -376,7 +424,10 @@ pub fn uniform_steps(t: f64, t_end: f64, dt: f64) -> (u64, f64) {
     (n as u64, span / n)
 }
 
-/// Finite-value guard shared by all steppers, applied before the model's own check.
+/// Finite-value guard shared by all steppers, applied before the model's own check. It sees the
+/// new state only, so its hint names the usual cause (a step beyond an explicit method's
+/// stability limit, which grows the state without bound) without blaming any one part of the
+/// model; the scene adds what it can tell from its settings (see `Scene::explain_failure`).
 pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<(), StepFailure> {
     if let Some(i) = y.iter().position(|v| !v.is_finite()) {
         return Err(StepFailure {
@@ -384,7 +435,7 @@ pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<
             problem: Problem {
                 swimmer: None,
                 cause: format!("state component {i} became NaN or infinite"),
-                hint: "use a smaller time step (the springs are stiff) or an adaptive integrator"
+                hint: "use a smaller time step (an explicit step beyond its stability limit grows the state without bound) or an adaptive integrator"
                     .into(),
                 fixes: vec![Setting::StableStep, Setting::DefaultIntegrator],
             },
@@ -411,24 +462,39 @@ pub(crate) fn tolerance_failure(time: f64, h: f64, rejects: u32) -> StepFailure 
     }
 }
 
-/// Whether an adaptive step `h` (s) at time `t` is too small to go on: below
-/// [`MIN_RELATIVE_INTERVAL`] of t, steps no longer advance the time measurably. An adaptive method
-/// that shrinks its step there is crawling towards an event it cannot pass (two spheres about to
-/// touch, where every larger step is refused by the contact guard), and stops with that event's
-/// error, or [`stalled`]'s, instead of spinning for ever.
-pub(crate) fn step_too_small(h: f64, t: f64) -> bool {
-    h < MIN_RELATIVE_INTERVAL * t.abs()
+/// The shortest adaptive step (s) at time `t` of a system whose time scale is `scale`
+/// ([`OdeSystem::time_scale`]): [`MIN_RELATIVE_INTERVAL`] of the longer of the two. Below it a
+/// step no longer advances t measurably, or a period would take more than 1e12 steps: at t = 0
+/// the time alone sets no floor, and a step the error estimate keeps that small would creep on
+/// for ever.
+pub(crate) fn step_floor(t: f64, scale: f64) -> f64 {
+    MIN_RELATIVE_INTERVAL * t.abs().max(scale)
 }
 
-/// The error of an adaptive method whose error estimate shrank its step below
-/// [`step_too_small`]'s floor.
-pub(crate) fn stalled(time: f64, h: f64) -> StepFailure {
+/// Whether an adaptive step `h` (s) at time `t` is below [`step_floor`]. An adaptive method that
+/// shrinks its step there is crawling towards an event it cannot pass (two spheres about to
+/// touch, where every larger step is refused by the contact guard), or its rates are far beyond
+/// what the scene's time scale can carry; it stops with that event's error, or [`stalled`]'s,
+/// instead of spinning for ever.
+pub(crate) fn step_too_small(h: f64, t: f64, scale: f64) -> bool {
+    h < step_floor(t, scale)
+}
+
+/// The error of an adaptive method whose error estimate held its step `h` at time `time` below
+/// [`step_floor`] of the start time `t` and the time scale `scale`.
+pub(crate) fn stalled(time: f64, h: f64, t: f64, scale: f64) -> StepFailure {
+    let floor = step_floor(t, scale);
+    let basis = if scale > t.abs() {
+        format!("{MIN_RELATIVE_INTERVAL:e} of the stroke period {scale:.6e} s: one period would take more than {:e} steps", 1.0 / MIN_RELATIVE_INTERVAL)
+    } else {
+        format!("what f64 can advance the time by at t = {t:.6e} s")
+    };
     StepFailure {
         time,
         problem: Problem {
             swimmer: None,
             cause: format!(
-                "the step fell to {h:e} s, below what f64 can advance the time by at t = {time:e} s, to keep the error estimate within tolerance"
+                "the step fell to {h:.3e} s, below {floor:.3e} s ({basis}), to keep the error estimate within tolerance"
             ),
             hint: "loosen the tolerance, or check the scene for NaN or nearly touching spheres"
                 .into(),

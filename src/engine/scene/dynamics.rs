@@ -2,6 +2,7 @@
 //! the right-hand side ([`OdeSystem`]) of the chosen model that every run and query uses.
 
 use super::*;
+use crate::engine::averaged::DEFAULT_SKIN_OF_CUTOFF;
 use crate::engine::integrators::{Stepper, Stroboscopic, Suspension, MIN_MACRO};
 
 impl Scene {
@@ -62,8 +63,13 @@ impl Scene {
         (&self.state, &self.base)
     }
 
-    /// The chosen model's right-hand side for the current settings (benchmarks and tests time and probe it).
+    /// The chosen model's right-hand side for the current settings (benchmarks and tests time and
+    /// probe it). A wall beyond the reach of the swimmers now in the scene (set before them, or
+    /// before a smaller one came) is refused here, where every run and rate starts.
     pub fn system(&self) -> Result<Box<dyn OdeSystem>> {
+        if let Some(w) = &self.wall {
+            self.check_wall_reach(w)?;
+        }
         Ok(match self.model {
             Model::Micro => {
                 let mut sys = MicroSystem::new(
@@ -76,6 +82,7 @@ impl Scene {
                 sys.set_thermal(self.thermal);
                 sys.set_mobility(self.mobility_operator()?);
                 sys.set_external(self.sphere_forces());
+                sys.set_reach(self.reach());
                 Box::new(sys)
             }
             Model::Rigid => {
@@ -114,18 +121,71 @@ impl Scene {
         // The constraint solve takes blocks, which are Beenakker's sums.
         sys.set_mobility(self.mobility_operator_by(EwaldMethod::Beenakker)?);
         sys.set_external(self.sphere_forces());
+        sys.set_reach(self.reach());
         Ok(sys)
     }
 
+    /// What makes the next run far costlier than its length suggests, each as a notice of its
+    /// kind with the fix: spectral Ewald sums chosen for a box of few spheres (its FFT grid is
+    /// transformed six times a product whatever the number of spheres, while Beenakker's sums
+    /// shrink as N²; below a quarter of the crossover they cost (700/N)² ≳ 16 times less); an
+    /// averaged suspension's cutoff set to half the box, which leaves its neighbour lists no
+    /// skin (every right-hand side rebuilds them).
+    pub fn cost_notices(&self) -> Vec<(&'static str, EngineError)> {
+        let mut out = Vec::new();
+        if let (Model::Averaged, Some(b), Some(c)) = (self.model, &self.periodic, self.cutoff) {
+            let half = 0.5 * b.shortest();
+            if self.count() >= crate::engine::averaged::LIST_SWIMMERS && c >= half {
+                out.push((
+                    "cutoff without skin",
+                    unsupported(
+                        format!(
+                            "this run will cost far more than its length suggests: the cutoff {c:e} m reaches half the box's shortest side, which leaves the neighbour lists of its {} swimmers no skin (pairs within the cutoff plus {:.0}% of it must meet one image), so every right-hand side rebuilds them; the box's default cutoff, {:.4e} m, keeps the skin, and the pairs it leaves out change the rates by far less than a suspension's tolerance",
+                            self.count(),
+                            100.0 * DEFAULT_SKIN_OF_CUTOFF,
+                            half / (1.0 + DEFAULT_SKIN_OF_CUTOFF)
+                        ),
+                        &[Setting::NoCutoff],
+                    ),
+                ));
+            }
+        }
+        let spheres = 2 * self.count();
+        if self.model == Model::Micro
+            && self.ewald_method == EwaldMethod::Spectral
+            && spheres < SPECTRAL_FROM_SPHERES / 4
+        {
+            if let Ok(Some(e)) = self.ewald() {
+                if let Some(g) = e.spectral() {
+                    let [a, b, c] = g.grid();
+                    out.push((
+                        "spectral Ewald",
+                        unsupported(
+                            format!(
+                                "this run will cost far more than its length suggests: spectral Ewald sums transform a {a}x{b}x{c} grid six times for every mobility product, whatever the number of spheres, and with {spheres} spheres Beenakker's sums (O(N^2), faster below {SPECTRAL_FROM_SPHERES} spheres) cost far less"
+                            ),
+                            &[Setting::EwaldMethod("auto"), Setting::EwaldMethod("beenakker")],
+                        ),
+                    ));
+                }
+            }
+        }
+        out
+    }
+
     /// The averaged model's cutoff: the one set; in a box at most half its shortest side (a pair
-    /// meets one image), and half that side when none is set.
+    /// meets one image), and when none is set the longest that leaves the neighbour lists their
+    /// skin within that half, L/2 / (1 + [`DEFAULT_SKIN_OF_CUTOFF`]) = 0.476 L. At L/2 itself
+    /// the lists would have no skin and every right-hand side would rebuild them, tens of times
+    /// the cost, for pair terms that change the rates by far less than a suspension's tolerance
+    /// (the measurements are in the book's "Suspensions, boxes and fields").
     pub fn averaged_cutoff(&self) -> Result<Option<f64>> {
         let Some(b) = &self.periodic else {
             return Ok(self.cutoff);
         };
         let half = 0.5 * b.shortest();
         match self.cutoff {
-            None => Ok(Some(half)),
+            None => Ok(Some(half / (1.0 + DEFAULT_SKIN_OF_CUTOFF))),
             Some(c) if c <= half => Ok(Some(c)),
             Some(c) => Err(invalid!(
                 "the averaged model's cutoff {c:e} m is longer than half the box's shortest side ({half:e} m): a pair would meet two images; set the cutoff to {half:e} m or less, or use a larger box"
@@ -193,8 +253,9 @@ const RELAXED_E_FOLDINGS: f64 = 37.0;
 
 impl Scene {
     /// What a stepper for `spec` was built from besides the spec: a cached one is reused only
-    /// while this stays. Direct methods take nothing from the scene; stroboscopic averaging and
-    /// `auto` take the swimmers' count, the model, μ, the common period and the RK4 step.
+    /// while this stays (and [`Scene::check_integrator`] passes). Direct methods take nothing
+    /// from the scene; stroboscopic averaging and `auto` take the swimmers' count, the model, μ,
+    /// the common period, the RK4 step and whether the scene is a suspension (`auto`'s choice).
     pub(crate) fn stepper_key(&self, spec: IntegratorSpec) -> Vec<u64> {
         match spec {
             IntegratorSpec::Stroboscopic { .. } | IntegratorSpec::Auto { .. } => vec![
@@ -203,6 +264,7 @@ impl Scene {
                 self.mu.to_bits(),
                 self.common_period().map_or(0, f64::to_bits),
                 self.default_micro_step().to_bits(),
+                u64::from(self.is_suspension()),
             ],
             _ => Vec::new(),
         }
@@ -212,7 +274,7 @@ impl Scene {
     /// the slowest spring relaxation (how many periods settle the springs after a start) and a
     /// length scale.
     pub(crate) fn stepper(&self, spec: IntegratorSpec) -> Result<Box<dyn Stepper>> {
-        self.check_noise(spec)?;
+        self.check_integrator(spec)?;
         if let Some(st) = spec.build() {
             return Ok(st);
         }
@@ -220,24 +282,12 @@ impl Scene {
             return self.stepper(self.auto_choice(tol)?.0);
         }
         if let IntegratorSpec::Suspension { tol } = spec {
-            if self.model != Model::Averaged {
-                return Err(unsupported(
-                    format!("{spec} is the averaged model's method for suspensions: the {} model's springs or strokes have no steric-contact structure for it to use", self.model.name()),
-                    &[Setting::Model("averaged"), Setting::DefaultIntegrator],
-                ));
-            }
             // The first step: one stroke period (the controller takes it from there).
             return Ok(Box::new(Suspension::new(tol, self.shortest_period())));
         }
         let IntegratorSpec::Stroboscopic { tol, inner } = spec else {
             return Err(invalid!("{spec} has no stepper"));
         };
-        if self.model == Model::Averaged {
-            return Err(unsupported(
-                "stroboscopic averaging is for the spring and rigid-stroke models: the averaged model is averaged already",
-                &[Setting::Model("micro"), Setting::Model("rigid"), Setting::DefaultIntegrator],
-            ));
-        }
         let period = self.common_period()?;
         let inner = inner
             .map(IntegratorSpec::from)
@@ -269,6 +319,25 @@ impl Scene {
             transient,
             length,
         )))
+    }
+
+    /// What refuses integrator `spec` on the scene as it is now: thermal noise's refusals,
+    /// `suspension` outside the averaged model, stroboscopic averaging inside it. Every run asks,
+    /// a cached stepper's too: the model, the temperature or the swimmers may have changed since
+    /// it was built.
+    pub(crate) fn check_integrator(&self, spec: IntegratorSpec) -> Result<()> {
+        self.check_noise(spec)?;
+        match spec {
+            IntegratorSpec::Suspension { .. } if self.model != Model::Averaged => Err(unsupported(
+                format!("{spec} is the averaged model's method for suspensions: the {} model's springs or strokes have no steric-contact structure for it to use", self.model.name()),
+                &[Setting::Model("averaged"), Setting::DefaultIntegrator],
+            )),
+            IntegratorSpec::Stroboscopic { .. } if self.model == Model::Averaged => Err(unsupported(
+                "stroboscopic averaging is for the spring and rigid-stroke models: the averaged model is averaged already",
+                &[Setting::Model("micro"), Setting::Model("rigid"), Setting::DefaultIntegrator],
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// What thermal noise refuses: the rigid-stroke model, deterministic integrators, and Platen's

@@ -98,6 +98,7 @@ impl Scene {
                     "the scene file has both a wall and a periodic box, which cannot go together; remove one"
                 ));
             }
+            self.check_wall_reach(&w)?;
             self.check_above(&w)?;
         }
         crate::engine::forces::ExternalForces::check_force(self.external.force)?;

@@ -564,6 +564,7 @@ impl Stepper for Suspension {
         let jac = sys.stiff_groups(t, y);
         let mut h = self.h.unwrap_or(self.first_step);
         let mut rejects = 0;
+        let scale = sys.time_scale();
         loop {
             let span = t_end - t;
             let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
@@ -579,9 +580,14 @@ impl Stepper for Suspension {
             let fac = controller_factor(err);
             match (accept, guard) {
                 (true, Ok(())) => {
+                    let h_next = h_try * fac;
+                    // A step below the floor that the error estimate does not let grow never
+                    // gets anywhere (a start from a tiny step grows up to 5× a step instead).
+                    if !last && h_next <= h_try && step_too_small(h_next, t, scale) {
+                        return Err(stalled(t_new, h_next, t, scale));
+                    }
                     y.copy_from_slice(&self.y_new);
                     stats.steps += 1;
-                    let h_next = h_try * fac;
                     // A step clipped to land on t_end says nothing about the natural step size.
                     self.h = Some(if last && h_try < h {
                         h.max(h_next)
@@ -600,7 +606,7 @@ impl Stepper for Suspension {
                     h = h_try * 0.25;
                     // Crawling towards the event the guard refuses: stop with it once the step no
                     // longer advances the time.
-                    if step_too_small(h, t) {
+                    if step_too_small(h, t, scale) {
                         self.h = Some(h_try);
                         return Err(failure);
                     }
@@ -612,8 +618,8 @@ impl Stepper for Suspension {
                         return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
                     }
                     h = h_try * fac.min(0.9);
-                    if step_too_small(h, t) {
-                        return Err(stalled(t_new, h));
+                    if step_too_small(h, t, scale) {
+                        return Err(stalled(t_new, h, t, scale));
                     }
                 }
             }

@@ -95,7 +95,7 @@ impl Suspension {
                 }
             } else {
                 hs = h_try * fac.min(0.9);
-                if step_too_small(hs, t + tau) || hs < 1e-12 * h {
+                if step_too_small(hs, t + tau, 0.0) || hs < 1e-12 * h {
                     return Err(Refusal::Failed);
                 }
             }
