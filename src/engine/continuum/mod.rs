@@ -24,18 +24,21 @@ mod spec;
 pub mod sphere;
 mod stability;
 
-pub use reading::{fourier_mode, particle_mode};
-pub use spec::{ContinuumSpec, MAX_CELLS, MAX_POPULATIONS};
+pub use reading::{fourier_mode, particle_mode, MAX_PARTICLE_MODE};
+pub use spec::{
+    ContinuumSpec, WholeOption, MAX_CELLS, MAX_POPULATIONS, MIN_CELLS_PER_AXIS,
+    MIN_CORE_IN_LENGTHS, MIN_DEGREE, MIN_TOL,
+};
 pub use stability::{BaseState, Mode};
 
 use self::kernel::Constants;
 use self::operator::{Kinetic, Operator};
-use self::spec::{check_spec, deposit, populations};
+use self::spec::{deposit, populations, Lengths};
 use self::sphere::monomial;
 use super::averaged::pair_constants;
 use super::error::{invalid, Result};
-use super::integrators::{Dopri5, Stats, Stepper};
-use super::scene::Scene;
+use super::integrators::{Dopri5, Horizon, Stats, Stepper};
+use super::scene::{Scene, MAX_TIME_IN_PERIODS};
 use super::swimmer::Dumbbell;
 use super::thermal::RigidDiffusion;
 use rustfft::num_complex::Complex64;
@@ -96,7 +99,6 @@ impl Continuum {
                 "the scene has no swimmers to build a continuum from; add some first"
             ));
         }
-        check_spec(spec)?;
         let first = scene.swimmers()[0];
         for (i, d) in scene.swimmers().iter().enumerate() {
             let same = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs());
@@ -111,13 +113,8 @@ impl Continuum {
                 ));
             }
         }
-        let core = spec.core.unwrap_or(first.ell);
         let cutoff = scene.averaged_cutoff()?.expect("a box always has a cutoff");
-        if !(core.is_finite() && core > 0.0 && core < cutoff) {
-            return Err(invalid!(
-                "the continuum's core {core:e} m must be positive and shorter than the cutoff {cutoff:e} m; e.g. core: 5e-6 (one length ℓ)"
-            ));
-        }
+        let Lengths { core, width } = spec.check(sides, cutoff, &first)?;
         let (pops, member) = populations(&scene.phases(), spec.phase_bins)?;
         let c = pair_constants(&first, scene.coefficients());
         let constants = Constants {
@@ -152,8 +149,6 @@ impl Continuum {
             &phases,
             diffusion,
         );
-        let h: [f64; 3] = std::array::from_fn(|d| sides[d] / spec.grid[d] as f64);
-        let width = spec.width.unwrap_or(h[0].max(h[1]).max(h[2]));
         let mut state = vec![0.0; pops.len() * op.sphere.len() * op.cells];
         let centres: Vec<_> = (0..scene.count())
             .map(|i| scene.center(i).map(|c| scene.shown(c)))
@@ -217,14 +212,17 @@ impl Continuum {
         self.interrupt = interrupt;
     }
 
-    /// Advance by `seconds`. On an error the state is the last accepted one.
+    /// Advance by `seconds`. Refused before it starts: a negative time, or an end past the
+    /// latest time a continuum may hold ([`Continuum::horizon`]). On an error the state is the
+    /// last accepted one.
     pub fn run(&mut self, seconds: f64) -> Result<()> {
-        if !(seconds.is_finite() && seconds >= 0.0) {
+        if seconds < 0.0 {
             return Err(invalid!(
-                "a continuum runs for a finite time of 0 s or more, got {seconds}"
+                "a continuum runs for 0 s or more, got {seconds:e} s; the dynamics cannot run backwards"
             ));
         }
         let end = self.time + seconds;
+        self.horizon().check(self.time, end)?;
         while self.time < end {
             if self.interrupt.as_ref().is_some_and(|stop| stop()) {
                 return Err(super::error::EngineError::Interrupted { time: self.time });
@@ -247,6 +245,19 @@ impl Continuum {
             }
         }
         Ok(())
+    }
+
+    /// The latest time a continuum may hold: [`MAX_TIME_IN_PERIODS`] of its stroke period, as a
+    /// scene (it starts at its scene's time).
+    pub fn horizon(&self) -> Horizon<'static> {
+        Horizon {
+            holder: "a continuum",
+            latest: MAX_TIME_IN_PERIODS * self.period,
+            max_periods: MAX_TIME_IN_PERIODS,
+            period: Some(self.period),
+            beyond: "",
+            restart: "build a new continuum from a scene at time 0",
+        }
     }
 
     /// Advance by `periods` stroke periods.
@@ -321,12 +332,22 @@ impl Continuum {
             .collect()
     }
 
+    /// Refuse a population index `p` this continuum does not have.
+    fn check_population(&self, p: usize) -> Result<()> {
+        let n = self.kinetic.pops;
+        if p < n {
+            return Ok(());
+        }
+        Err(invalid!(
+            "population {p} does not exist: this continuum has {n} ({}), numbered from 0 in the order of its populations",
+            if n == 1 { "0".to_string() } else { format!("0 to {}", n - 1) }
+        ))
+    }
+
     /// The mean-field rates (dR_H/dt, dN/dt) of a swimmer of population `p` with orientation `n`
     /// at every cell centre: the particles' averaged rates summed over the distribution.
     pub fn mean_field(&self, p: usize, n: [f64; 3]) -> Result<Vec<([f64; 3], [f64; 3])>> {
-        if p >= self.kinetic.pops {
-            return Err(invalid!("population {p} does not exist"));
-        }
+        self.check_population(p)?;
         let op = &self.kinetic.op;
         let u = op.mean_field_terms(&self.state, self.kinetic.pops, p);
         let mut out = vec![([0.0; 3], [0.0; 3]); op.cells];

@@ -33,9 +33,7 @@ impl Continuum {
         p: usize,
         f: impl Fn([f64; 3], [f64; 3]) -> f64,
     ) -> Result<()> {
-        if p >= self.kinetic.pops {
-            return Err(invalid!("population {p} does not exist"));
-        }
+        self.check_population(p)?;
         let op = &self.kinetic.op;
         let b = op.sphere.len();
         let cells = op.cells;
@@ -56,9 +54,12 @@ impl Continuum {
     }
 
     /// Set the state to a homogeneous `base` at each population's mean density, plus a plane
-    /// wave of relative amplitude `amplitude` at box mode `mode` in the population `population`'s
-    /// (all when `None`) density (`shape` "density"), polarization along `axis`
+    /// wave cos(k·x) of relative amplitude `amplitude` at box mode `mode` in the population
+    /// `population`'s (all when `None`) density (`shape` "density"), polarization along `axis`
     /// (c(n) gains 3 axis·n) or nematic order along `axis` (gains (15/2)(axis·n)² − 5/2).
+    /// Refused, the state unchanged: a population that does not exist, mode 0 (the mean, which
+    /// would change the conserved numbers), a mode the grid does not hold, an amplitude that would
+    /// make f negative somewhere ([`largest_amplitude`]).
     #[allow(clippy::too_many_arguments)]
     pub fn perturb(
         &mut self,
@@ -69,33 +70,47 @@ impl Continuum {
         amplitude: f64,
         population: Option<usize>,
     ) -> Result<()> {
+        if let Some(p) = population {
+            self.check_population(p)?;
+        }
+        if mode == [0, 0, 0] {
+            return Err(invalid!(
+                "box mode [0, 0, 0] is no wave but the mean: a perturbation there would change each population's number of swimmers, which the dynamics conserves; give a mode with a nonzero entry, e.g. [1, 0, 0]"
+            ));
+        }
+        self.check_mode(mode)?;
         if !amplitude.is_finite() {
             return Err(invalid!(
                 "a perturbation's amplitude must be a finite number, got {amplitude}"
             ));
         }
         let coef = self.base_coefficients(base)?;
+        let e = match unit(axis) {
+            Some(e) => e,
+            None if shape == FieldKind::Density => [0.0, 0.0, 1.0],
+            None => {
+                return Err(invalid!(
+                "a perturbation's axis must be a nonzero vector of finite components, got {axis:?}"
+            ))
+            }
+        };
+        let most = largest_amplitude(base, shape, e);
+        // The bound's own round-off (1e-9) aside, so that a bound typed in full passes.
+        if amplitude.abs() > most * (1.0 + 1e-9) {
+            return Err(invalid!(
+                "a {} wave of relative amplitude {amplitude:e} would make the distribution negative for some orientations (where cos(k·x) has the sign that lowers it); about this state its amplitude must lie within ±{most:.6} so that f ≥ 0 everywhere: give a smaller amplitude",
+                shape.name()
+            ));
+        }
         let op = &self.kinetic.op;
         let b = op.sphere.len();
         let cells = op.cells;
         let sphere = &op.sphere;
-        let norm = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-        if norm.is_nan() || (norm <= 0.0 && shape != FieldKind::Density) {
-            return Err(invalid!("a perturbation's axis must be a nonzero vector"));
-        }
-        let e = axis.map(|x| x / norm.max(1e-300));
         // The angular shape g(n) of the perturbation, projected on the basis.
         let shape_at: Vec<f64> = sphere
             .nodes
             .iter()
-            .map(|n| {
-                let c = e[0] * n[0] + e[1] * n[1] + e[2] * n[2];
-                match shape {
-                    FieldKind::Density => 1.0,
-                    FieldKind::Polarization => 3.0 * c,
-                    FieldKind::Nematic => 7.5 * c * c - 2.5,
-                }
-            })
+            .map(|n| shape_value(shape, e[0] * n[0] + e[1] * n[1] + e[2] * n[2]))
             .collect();
         let mut g = vec![0.0; b];
         sphere.project(&shape_at, &mut g);
@@ -210,4 +225,83 @@ impl Continuum {
         *scene = trial;
         Ok(())
     }
+}
+
+/// The angular shape g of a perturbation of `shape` at c = axis·n.
+fn shape_value(shape: FieldKind, c: f64) -> f64 {
+    match shape {
+        FieldKind::Density => 1.0,
+        FieldKind::Polarization => 3.0 * c,
+        FieldKind::Nematic => 7.5 * c * c - 2.5,
+    }
+}
+
+/// `v` scaled to length 1, if it has a direction.
+fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+    let big = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    if !(big.is_finite() && big > 0.0) {
+        return None;
+    }
+    let w = v.map(|x| x / big);
+    let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+    Some(w.map(|x| x / n))
+}
+
+/// The largest |amplitude| of a wave of `shape` along the unit `axis` about `base` that keeps f
+/// ≥ 0 at every orientation and place: f ∝ 1 + 3P·n + A g(axis·n) cos(k·x) with cos(k·x) of
+/// either sign, so |A| ≤ min over n of (1 + 3P·n)/|g(axis·n)|. That is 1 − 3|P| for the density
+/// (g = 1). Otherwise n enters through axis·n and P·n alone, and for fixed axis·n the ratio grows
+/// with P·n, so the minimum lies on the great circle through the axis and P (any through the
+/// axis when P is along it or 0): sampled at 2^12 points, the least refined by golden sections
+/// between its neighbours (to round-off).
+fn largest_amplitude(base: &BaseState, shape: FieldKind, axis: [f64; 3]) -> f64 {
+    let p = match base {
+        BaseState::Isotropic => [0.0; 3],
+        BaseState::Polar(p) => *p,
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    if shape == FieldKind::Density {
+        return (1.0 - 3.0 * dot(p, p).sqrt()).max(0.0);
+    }
+    let along = dot(p, axis);
+    let rest: [f64; 3] = std::array::from_fn(|d| p[d] - along * axis[d]);
+    let other = unit(rest)
+        .filter(|_| dot(rest, rest).sqrt() > 1e-12 * dot(p, p).sqrt())
+        .unwrap_or_else(|| {
+            // Any direction across the axis.
+            let k = if axis[0].abs() < 0.9 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            let c = dot(k, axis);
+            unit(std::array::from_fn(|d| k[d] - c * axis[d])).expect("across the axis")
+        });
+    let ratio = |t: f64| {
+        let (s, c) = t.sin_cos();
+        let n: [f64; 3] = std::array::from_fn(|d| c * axis[d] + s * other[d]);
+        let g = shape_value(shape, c).abs();
+        if g > 0.0 {
+            (1.0 + 3.0 * dot(p, n)) / g
+        } else {
+            f64::INFINITY
+        }
+    };
+    const SAMPLES: usize = 1 << 12;
+    let step = 2.0 * PI / SAMPLES as f64;
+    let best = (0..SAMPLES)
+        .map(|j| j as f64 * step)
+        .min_by(|a, b| ratio(*a).total_cmp(&ratio(*b)))
+        .expect("samples");
+    let (mut lo, mut hi) = (best - step, best + step);
+    let golden = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..80 {
+        let (a, b) = (hi - golden * (hi - lo), lo + golden * (hi - lo));
+        if ratio(a) <= ratio(b) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    ratio(best).min(ratio(0.5 * (lo + hi))).max(0.0)
 }

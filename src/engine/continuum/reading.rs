@@ -15,13 +15,7 @@ impl Continuum {
     pub fn field(&self, kind: FieldKind, population: Option<usize>) -> Result<Field> {
         let op = &self.kinetic.op;
         if let Some(p) = population {
-            if p >= self.kinetic.pops {
-                return Err(invalid!(
-                    "population {p} does not exist: this continuum has {} (0 to {})",
-                    self.kinetic.pops,
-                    self.kinetic.pops - 1
-                ));
-            }
+            self.check_population(p)?;
         }
         let b = op.sphere.len();
         let cells = op.cells;
@@ -108,12 +102,32 @@ impl Continuum {
         population: Option<usize>,
         mode: [i64; 3],
     ) -> Result<Vec<Complex64>> {
+        self.check_mode(mode)?;
         let f = self.field(kind, population)?;
         let rho = match kind {
             FieldKind::Density => None,
             _ => Some(self.field(FieldKind::Density, population)?),
         };
         Ok(fourier_mode(&f, rho.as_ref(), self.sides, mode))
+    }
+
+    /// The largest |n| per axis of the box modes the state holds: the 2/3 rule against aliasing
+    /// keeps 3|n| < cells.
+    pub fn largest_modes(&self) -> [i64; 3] {
+        self.grid.map(|n| ((n - 1) / 3) as i64)
+    }
+
+    /// Refuse a box mode the grid does not hold: the state has none beyond the 2/3 rule, and at
+    /// the cell centres a shorter wave is a longer one's alias (a whole number of cells: the mean).
+    pub(super) fn check_mode(&self, mode: [i64; 3]) -> Result<()> {
+        let most = self.largest_modes();
+        if (0..3).all(|d| mode[d].unsigned_abs() <= most[d].unsigned_abs()) {
+            return Ok(());
+        }
+        Err(invalid!(
+            "box mode {mode:?} is beyond what this continuum's grid {:?} holds: the 2/3 rule against aliasing keeps |n| up to {most:?} per axis (under a third of the cells; at the cells a shorter wave is the alias of a longer one); give a mode within that, or build the continuum on a finer grid",
+            self.grid
+        ))
     }
 
     /// The complex amplitudes δc_{p,i} = (1/cells) Σ_x c_{p,i}(x) e^{−ik·x} of the state at box
@@ -175,18 +189,44 @@ pub fn particle_mode(
 ) -> Result<Vec<Complex64>> {
     let Some(b) = scene.periodic() else {
         return Err(invalid!(
-            "a Fourier mode is taken over a periodic box's wave vectors, and this scene has none; set s.box first"
+            "a Fourier mode is taken over a periodic box's wave vectors, and this scene has none; set a box first"
         ));
     };
+    if mode.iter().any(|n| n.unsigned_abs() > MAX_PARTICLE_MODE) {
+        return Err(invalid!(
+            "box mode {mode:?} is beyond what f64 resolves: the phase 2π n·x/L of a swimmer carries a round-off of ~n·1e-15 rad, so modes go up to {MAX_PARTICLE_MODE:e} per axis (1e-6 rad); give a smaller mode"
+        ));
+    }
+    if let Some(p) = phase {
+        if !p.is_finite() {
+            return Err(invalid!(
+                "a phase must be a finite number in rad, got {p}; give one of the swimmers' phases, or none for every swimmer"
+            ));
+        }
+        let present = distinct_phases(scene);
+        if !present.iter().any(|q| same_phase(*q, p)) {
+            let shown: Vec<String> = present
+                .iter()
+                .take(MAX_PHASES_SHOWN)
+                .map(|q| format!("{q}"))
+                .collect();
+            return Err(invalid!(
+                "no swimmer has phase {p} rad (to {SAME_PHASE:e} rad, modulo 2π): the sum would be over none; the phases present are {}{} rad",
+                shown.join(", "),
+                if present.len() > MAX_PHASES_SHOWN {
+                    format!(" and {} more", present.len() - MAX_PHASES_SHOWN)
+                } else {
+                    String::new()
+                }
+            ));
+        }
+    }
     let sides = b.sides();
     let comps = kind.components();
     let mut out = vec![Complex64::default(); comps];
     for (i, d) in scene.swimmers().iter().enumerate() {
-        if let Some(p) = phase {
-            let diff = (d.phase - p).rem_euclid(2.0 * PI);
-            if diff.min(2.0 * PI - diff) > SAME_PHASE {
-                continue;
-            }
+        if phase.is_some_and(|p| !same_phase(d.phase, p)) {
+            continue;
         }
         let r = scene.shown(scene.center(i)?);
         let n = scene.dir(i)?;
@@ -208,6 +248,30 @@ pub fn particle_mode(
         }
     }
     Ok(out)
+}
+
+/// The largest |n| per axis of a box mode of the particles: the phase 2π n·x/L then still holds
+/// to ~1e-6 rad in f64 (x within half a side, its round-off ~1e-16 of the side).
+pub const MAX_PARTICLE_MODE: u64 = 1_000_000_000;
+
+/// The most phases a message lists.
+const MAX_PHASES_SHOWN: usize = 16;
+
+/// Whether phases `a` and `b` (rad) are one, modulo 2π.
+fn same_phase(a: f64, b: f64) -> bool {
+    let d = (a - b).rem_euclid(2.0 * PI);
+    d.min(2.0 * PI - d) <= SAME_PHASE
+}
+
+/// The distinct phases of `scene`'s swimmers, in [0, 2π), in order of first appearance.
+fn distinct_phases(scene: &Scene) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::new();
+    for d in scene.swimmers() {
+        if !out.iter().any(|q| same_phase(*q, d.phase)) {
+            out.push(d.phase.rem_euclid(2.0 * PI));
+        }
+    }
+    out
 }
 
 /// The Fourier amplitude of field `f` (times the density `rho` for Π and Q) at box mode `mode`.

@@ -6,6 +6,8 @@ use super::sphere::MAX_DEGREE;
 use super::Population;
 use crate::engine::error::{invalid, Result};
 use crate::engine::fields::gaussian_axis;
+use crate::engine::integrators::{check_tolerance, MIN_DRIFT_TOL};
+use crate::engine::swimmer::Dumbbell;
 use std::f64::consts::PI;
 
 /// The most grid cells a continuum takes (its kernel then holds some 600 transforms of 32³).
@@ -47,41 +49,114 @@ impl Default for ContinuumSpec {
     }
 }
 
-pub(super) fn check_spec(spec: &ContinuumSpec) -> Result<()> {
-    let cells: usize = spec.grid.iter().product();
-    if spec.grid.iter().any(|&n| n < 4) || cells > MAX_CELLS {
-        return Err(invalid!(
-            "a continuum's grid needs 4 or more cells per axis and at most {MAX_CELLS} cells in all, got {:?}; e.g. grid: [16, 16, 16]",
-            spec.grid
-        ));
-    }
-    if spec.degree < 2 || spec.degree > MAX_DEGREE {
-        return Err(invalid!(
-            "a continuum's orientations go to harmonic degree 2 to {MAX_DEGREE} (the mean field needs 2), got {}; e.g. orientations: 4",
-            spec.degree
-        ));
-    }
-    if let Some(w) = spec.width {
-        if !(w.is_finite() && w > 0.0) {
-            return Err(invalid!(
-                "a continuum's smoothing width must be a positive length in m, got {w}"
-            ));
+/// The least cells per axis of a continuum's grid (the 2/3 rule then keeps modes −1 to 1).
+pub const MIN_CELLS_PER_AXIS: usize = 4;
+
+/// The least harmonic degree of the orientations: the mean field reads second moments.
+pub const MIN_DEGREE: usize = 2;
+
+/// The least tolerance of a continuum's time stepping.
+pub const MIN_TOL: f64 = MIN_DRIFT_TOL;
+
+/// The least core, in swimmer lengths ℓ: the pair terms are the leading terms of an expansion in
+/// ℓ/D for swimmers far apart, so they describe pairs about a length apart or more; at ℓ/4 their
+/// (ℓ/D)⁵ term is already 4⁵ ≈ 1000 times its size at one length. (The cost does not follow the
+/// core: the kernel's radial panels grow with log(cutoff/core), and its transform at the kept
+/// waves depends on the core only logarithmically.)
+pub const MIN_CORE_IN_LENGTHS: f64 = 0.25;
+
+/// The whole-number options of a continuum: the values each accepts, in words, so that the spec's
+/// refusals and a front end's (a value that is no whole number at all) say the same.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WholeOption {
+    /// Cells per axis.
+    Grid,
+    /// The harmonic degree of the orientations.
+    Degree,
+    /// Phase bins.
+    PhaseBins,
+}
+
+impl WholeOption {
+    /// What the option accepts.
+    pub fn accepts(self) -> String {
+        match self {
+            WholeOption::Grid => format!(
+                "{MIN_CELLS_PER_AXIS} or more cells per axis and at most {MAX_CELLS} cells in all (e.g. 16 per axis)"
+            ),
+            WholeOption::Degree => format!(
+                "a harmonic degree from {MIN_DEGREE} (the mean field reads second moments) to {MAX_DEGREE} (e.g. 4)"
+            ),
+            WholeOption::PhaseBins => format!("1 to {MAX_POPULATIONS} phase bins"),
         }
     }
-    if !(spec.tol.is_finite() && spec.tol > 0.0 && spec.tol < 1.0) {
-        return Err(invalid!(
-            "a continuum's tolerance must lie between 0 and 1, got {}; e.g. tol: 1e-6",
-            spec.tol
-        ));
-    }
-    if let Some(b) = spec.phase_bins {
-        if b == 0 || b > MAX_POPULATIONS {
+}
+
+/// The core and the smoothing width a spec gives (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Lengths {
+    pub(super) core: f64,
+    pub(super) width: f64,
+}
+
+impl ContinuumSpec {
+    /// Every option checked in one place, the lengths against what the box (`sides`, m), the
+    /// scene's `cutoff` (m) and the swimmer `kind` allow; the core and width it gives.
+    pub(super) fn check(&self, sides: [f64; 3], cutoff: f64, kind: &Dumbbell) -> Result<Lengths> {
+        let cells = self
+            .grid
+            .iter()
+            .try_fold(1usize, |acc, &n| acc.checked_mul(n));
+        if self.grid.iter().any(|&n| n < MIN_CELLS_PER_AXIS) || cells.is_none_or(|c| c > MAX_CELLS)
+        {
             return Err(invalid!(
-                "phase bins must be 1 to {MAX_POPULATIONS}, got {b}"
+                "a continuum's grid takes {}, got {:?}",
+                WholeOption::Grid.accepts(),
+                self.grid
             ));
         }
+        if !(MIN_DEGREE..=MAX_DEGREE).contains(&self.degree) {
+            return Err(invalid!(
+                "a continuum's orientations take {}, got {}",
+                WholeOption::Degree.accepts(),
+                self.degree
+            ));
+        }
+        if let Some(b) = self.phase_bins {
+            if !(1..=MAX_POPULATIONS).contains(&b) {
+                return Err(invalid!(
+                    "a continuum's phases take {}, got {b}",
+                    WholeOption::PhaseBins.accepts()
+                ));
+            }
+        }
+        check_tolerance(
+            "a continuum's tolerance",
+            self.tol,
+            MIN_TOL,
+            "the error asked of a structure of 1e-6 of the density is under f64's round-off of the density",
+        )?;
+        let cell = (0..3)
+            .map(|d| sides[d] / self.grid[d] as f64)
+            .fold(0.0, f64::max);
+        let longest = sides.iter().copied().fold(0.0, f64::max);
+        let width = self.width.unwrap_or(cell);
+        let (narrowest, widest) = (0.25 * cell, 0.5 * longest);
+        if !(narrowest..=widest).contains(&width) {
+            return Err(invalid!(
+                "a continuum's smoothing width must lie from a quarter of its largest cell side, {narrowest:e} m (narrower, the Gaussian falls between the cell centres: each swimmer lands in one cell, and far narrower its weights underflow to nothing), to half the box's longest side, {widest:e} m (wider, it spreads every swimmer evenly over the box), got {width:e} m; leave it out for one cell, {cell:e} m"
+            ));
+        }
+        let ell = kind.ell;
+        let core = self.core.unwrap_or(ell);
+        let least = MIN_CORE_IN_LENGTHS * ell;
+        if !(core >= least && core < cutoff) {
+            return Err(invalid!(
+                "a continuum's core must lie from {MIN_CORE_IN_LENGTHS} swimmer lengths, {least:e} m, up to the cutoff {cutoff:e} m (not included), got {core:e} m: the pair terms are the leading terms of an expansion in ℓ/D for swimmers far apart, and closer than ℓ/4, where their (ℓ/D)⁵ term is 1000 times its size at one length, they describe no pair the particles have; leave it out for one length ℓ, {ell:e} m"
+            ));
+        }
+        Ok(Lengths { core, width })
     }
-    Ok(())
 }
 
 /// The phase populations of swimmers with phases `phases` (one per distinct phase, or `bins`
