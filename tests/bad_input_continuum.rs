@@ -1,7 +1,8 @@
 //! The continuum tried as a hostile new user would ("nothing lost, nothing hangs", round three):
 //! every run-like call checks its horizon and tolerance before it starts, every option and length
 //! is checked against what the grid and the box hold, a perturbation keeps the distribution a
-//! distribution and the conserved numbers, and modes are the ones the grid or f64 resolve. Each case runs in its own
+//! distribution and the conserved numbers, modes are the ones the grid or f64 resolve, and a
+//! continuum a sweep's calls share is refused in swimlab's words. Each case runs in its own
 //! `swimlab` process under a time limit, so a hang fails the test instead of stalling it, and a
 //! panic shows as the "internal error" the script boundary turns it into.
 
@@ -435,6 +436,40 @@ fn continuum_options_state_their_ranges() {
             1,
         );
     }
+}
+
+/// A continuum a sweep's calls share is read by them, not changed: a change is swimlab's refusal
+/// naming the fix (a copy), never Rhai's "Data race detected"; a copy runs in each call.
+#[test]
+fn a_continuum_shared_by_a_sweep_is_read_not_changed() {
+    for change in ["c.run_periods(0.01)", "c.perturb(#{ amplitude: 0.1 })"] {
+        case(
+            &format!("{C}let r = sweep([1, 2, 3, 4, 5, 6, 7, 8], |p| {{ {change}; c.time }});"),
+            &[
+                "this continuum is shared by every call of the sweep",
+                "change a copy there (let d = c.copy(); d.run_periods(1); ...)",
+            ],
+            1,
+        );
+    }
+    case(
+        &format!("{C}c.perturb(#{{ amplitude: 0.5 }});\nlet r = sweep([1, 2, 3, 4], |p| {{ let d = c.copy(); d.run_periods(0.01 * p); [d.time > 0.0, c.time, d.counts()[0] > 0.99, c.mode(\"density\", [1, 0, 0]).abs > 0.0] }});\nprint(r);\nprint(c.time);"),
+        &["[true, 0.0, true, true]", "\n0.0\n"],
+        0,
+    );
+    // Long readings at once (draws of 20,000 swimmers, ~0.5 s each) wait for the continuum's own
+    // lock; Rhai's lock on the captured variable gave up after a few milliseconds ("Data race").
+    case(
+        "let side = 400e-6;\nlet s = scene();\ns.model = \"averaged\";\ns.box = [side, side, side];\ns.add_random(dumbbell(), 40, 1, #{ phase: 0.0 });\ns.add_random(dumbbell(), 40, 2, #{ phase: pi() / 2.0 });\nlet c = continuum(s, #{ grid: 16, orientations: 4 });\nc.perturb(#{ amplitude: 0.5 });\nprint(sweep([1, 2, 3, 4], |seed| { let t = scene(); t.model = \"averaged\"; t.box = [side, side, side]; c.sample(t, 20000, seed); t.count }));",
+        &["[20000, 20000, 20000, 20000]"],
+        0,
+    );
+    // Given in more than one parameter, it is shared as well.
+    case(
+        &format!("{C}let r = sweep([c, c], |d| {{ d.run_periods(0.01); 1 }});"),
+        &["this continuum is shared by every call of the sweep"],
+        1,
+    );
 }
 
 /// ∫ D^{2−m} S(D) j_l(kD) dD from `core` to `cutoff` for l = 0..=6, m = 3, 4, 5 by Simpson's rule,

@@ -43,6 +43,7 @@ use super::swimmer::Dumbbell;
 use super::thermal::RigidDiffusion;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// One phase population.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,7 +54,9 @@ pub struct Population {
     pub swimmers: usize,
 }
 
-/// A continuum: the distribution, its time, and the stepper.
+/// A continuum: the distribution, its time, and the stepper. A clone is an independent copy (the
+/// operator, which no run changes, shared).
+#[derive(Clone)]
 pub struct Continuum {
     kinetic: Kinetic,
     state: Vec<f64>,
@@ -161,7 +164,7 @@ impl Continuum {
         );
         let kinetic = Kinetic {
             pops: pops.len(),
-            op,
+            op: Arc::new(op),
         };
         let mut c = Continuum {
             kinetic,

@@ -9,6 +9,7 @@ use crate::engine::thermal::RigidDiffusion;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// The mean-field operator's parts that do not change in a run.
 pub(super) struct Operator {
@@ -41,8 +42,9 @@ pub(super) struct Operator {
 }
 
 /// The distribution's ODE: state y[(p·B + i)·cells + cell] = c_{p,i}(x_cell), f_p = Σ_i c_{p,i} Y_i.
+#[derive(Clone)]
 pub(super) struct Kinetic {
-    pub(super) op: Operator,
+    pub(super) op: Arc<Operator>,
     pub(super) pops: usize,
 }
 
