@@ -3,7 +3,7 @@
 //! there, with the run's interrupt and a workspace of their own.
 
 use super::error::{invalid, EngineError, Result};
-use super::integrators::require_resolvable;
+use super::integrators::{require_resolvable, Horizon};
 use super::model::{vec3, Model, STATE_PER_SWIMMER};
 use super::plan::plan;
 use super::scene::{Scene, MAX_TIME_IN_PERIODS};
@@ -39,22 +39,15 @@ pub fn check_steps(s: &Scene, t_end: f64) -> Result<()> {
     if t_end <= s.time() {
         return Ok(());
     }
-    let latest = s.latest_time();
-    // A NaN end is not within the latest time: refused as well.
-    let within = t_end <= latest;
-    if !within {
-        let periods = |t: f64| {
-            s.period()
-                .map_or(String::new(), |p| format!(" ({:.6e} periods)", t / p))
-        };
-        return Err(invalid!(
-            "this run would end at t = {t_end:.6e} s{}, past the latest time a scene may hold, {latest:.6e} s{} ({MAX_TIME_IN_PERIODS:e} stroke periods: beyond, f64 no longer resolves the stroke, and a saved scene would not load); run at most {:.6e} s{} more, or continue in a new scene from time 0",
-            periods(t_end),
-            periods(latest),
-            latest - s.time(),
-            periods(latest - s.time()),
-        ));
+    Horizon {
+        holder: "a scene",
+        latest: s.latest_time(),
+        max_periods: MAX_TIME_IN_PERIODS,
+        period: s.period().ok(),
+        beyond: ", and a saved scene would not load",
+        restart: "continue in a new scene from time 0",
     }
+    .check(s.time(), t_end)?;
     if let Some(dt) = s.integrator().fixed_step() {
         let scale = s.time().abs().max(t_end.abs());
         require_resolvable(

@@ -6,19 +6,72 @@
 use super::convert::{array3, describe, lift, number, script_error, vector3, ScriptResult};
 use super::doc::{doc_entry, Doc};
 use super::scene_api::SceneHandle;
-use crate::engine::continuum::{particle_mode, BaseState, Continuum, ContinuumSpec, Mode};
+use crate::engine::continuum::{
+    particle_mode, BaseState, Continuum, ContinuumSpec, Mode, WholeOption,
+};
 use crate::engine::fields::{Field, FieldKind};
 use rhai::{Array, Dynamic, Engine, Map, INT};
 use rustfft::num_complex::Complex64;
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// A continuum shared by the script values that name it.
 #[derive(Clone)]
-pub struct ContinuumHandle(Arc<Mutex<Continuum>>);
+pub struct ContinuumHandle {
+    continuum: Arc<Mutex<Continuum>>,
+    /// The sweeps whose calls share this continuum now: while any does, it can be read, not
+    /// changed.
+    shared_by_sweeps: Arc<AtomicUsize>,
+}
+
+/// While this lives, the continuums it holds are shared by the calls of a sweep (see
+/// [`ContinuumHandle::lock_mut`]).
+pub(super) struct ContinuumSweepShare(Vec<ContinuumHandle>);
+
+impl Drop for ContinuumSweepShare {
+    fn drop(&mut self) {
+        for h in &self.0 {
+            h.shared_by_sweeps.fetch_sub(1, Ordering::SeqCst);
+        }
+    }
+}
 
 impl ContinuumHandle {
-    fn lock(&self) -> std::sync::MutexGuard<'_, Continuum> {
-        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    fn new(c: Continuum) -> Self {
+        ContinuumHandle {
+            continuum: Arc::new(Mutex::new(c)),
+            shared_by_sweeps: Arc::default(),
+        }
+    }
+
+    /// Whether `other` is a handle on the same continuum.
+    pub(super) fn same(&self, other: &ContinuumHandle) -> bool {
+        Arc::ptr_eq(&self.continuum, &other.continuum)
+    }
+
+    /// Mark `continuums` as shared by the calls of a sweep for as long as the result lives.
+    pub(super) fn share_in_sweep(continuums: Vec<ContinuumHandle>) -> ContinuumSweepShare {
+        for h in &continuums {
+            h.shared_by_sweeps.fetch_add(1, Ordering::SeqCst);
+        }
+        ContinuumSweepShare(continuums)
+    }
+
+    /// Read the continuum. A lock poisoned by a panic elsewhere still holds a consistent one
+    /// (every change is made whole or not at all), so it is read anyway.
+    fn lock(&self) -> MutexGuard<'_, Continuum> {
+        self.continuum.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Change the continuum; refused while the calls of a sweep share it: they run at once on
+    /// several threads, and changes from them would race (results changing from run to run).
+    fn lock_mut(&self) -> ScriptResult<MutexGuard<'_, Continuum>> {
+        if self.shared_by_sweeps.load(Ordering::SeqCst) > 0 {
+            return Err(script_error(
+                "this continuum is shared by every call of the sweep (captured by its closure, or given in more than one parameter), and the calls run at once on several threads: changing it from them would race, and the results would change from run to run; a call may read it, not change it: build the continuum inside the closure, or change a copy there (let d = c.copy(); d.run_periods(1); ...)",
+            ));
+        }
+        Ok(self.lock())
     }
 }
 
@@ -45,13 +98,16 @@ impl std::fmt::Display for ContinuumHandle {
 
 const FIX: &str = "use #{ grid: 16 or [nx, ny, nz], orientations: 4, core: metres, width: metres, phases: bins, tol: 1e-6 }";
 
-fn whole(what: &str, v: &Dynamic) -> ScriptResult<usize> {
+/// A whole-number option of `continuum(s, opts)`: anything but a whole number of 0 or more is
+/// refused with what the option accepts (the engine's words, as its own refusals say).
+fn whole(what: &str, option: WholeOption, v: &Dynamic) -> ScriptResult<usize> {
     v.as_int()
         .ok()
         .and_then(|n| usize::try_from(n).ok())
         .ok_or_else(|| {
             script_error(format!(
-                "{what} must be a whole number of 0 or more, got {}",
+                "{what} takes {}, got {}",
+                option.accepts(),
                 describe(v)
             ))
         })
@@ -62,25 +118,26 @@ fn spec(opts: &Map) -> ScriptResult<ContinuumSpec> {
     for (k, v) in opts {
         match k.as_str() {
             "grid" => {
-                if let Ok(n) = v.as_int() {
-                    s.grid = [usize::try_from(n).unwrap_or(0); 3];
+                if v.is_int() {
+                    s.grid = [whole("continuum grid", WholeOption::Grid, v)?; 3];
                 } else {
                     let arr = v.clone().try_cast::<Array>().filter(|a| a.len() == 3);
                     let Some(arr) = arr else {
                         return Err(script_error(format!(
-                            "continuum grid must be a cell count such as 16 or three such as [16, 16, 16], got {}",
+                            "continuum grid must be a cell count such as 16 or three such as [16, 16, 16] ({}), got {}",
+                            WholeOption::Grid.accepts(),
                             describe(v)
                         )));
                     };
                     for (d, x) in arr.iter().enumerate() {
-                        s.grid[d] = whole(&format!("continuum grid[{d}]"), x)?;
+                        s.grid[d] = whole(&format!("continuum grid[{d}]"), WholeOption::Grid, x)?;
                     }
                 }
             }
-            "orientations" => s.degree = whole("continuum orientations (harmonic degree)", v)?,
+            "orientations" => s.degree = whole("continuum orientations", WholeOption::Degree, v)?,
             "core" => s.core = Some(number("continuum core", v)?),
             "width" => s.width = Some(number("continuum width", v)?),
-            "phases" => s.phase_bins = Some(whole("continuum phases (bins)", v)?),
+            "phases" => s.phase_bins = Some(whole("continuum phases", WholeOption::PhaseBins, v)?),
             "tol" => s.tol = number("continuum tol", v)?,
             other => {
                 return Err(script_error(format!(
@@ -95,11 +152,11 @@ fn spec(opts: &Map) -> ScriptResult<ContinuumSpec> {
 fn build(s: &SceneHandle, opts: &Map) -> ScriptResult<ContinuumHandle> {
     let sp = spec(opts)?;
     let c = s.with(|sc| Continuum::of(sc, &sp))?;
-    Ok(ContinuumHandle(Arc::new(Mutex::new(c))))
+    Ok(ContinuumHandle::new(c))
 }
 
 fn run(c: &ContinuumHandle, seconds: f64) -> ScriptResult<()> {
-    let mut g = c.lock();
+    let mut g = c.lock_mut()?;
     g.set_interrupt(Some(Arc::new(super::interrupt::requested)));
     let r = g.run(seconds);
     g.set_interrupt(None);
@@ -111,7 +168,15 @@ fn field_kind(name: &str) -> ScriptResult<FieldKind> {
 }
 
 fn population(v: &Dynamic) -> ScriptResult<usize> {
-    whole("a population index", v)
+    v.as_int()
+        .ok()
+        .and_then(|n| usize::try_from(n).ok())
+        .ok_or_else(|| {
+            script_error(format!(
+                "a population index is a whole number from 0 (see c.populations), got {}",
+                describe(v)
+            ))
+        })
 }
 
 fn complex_map(v: &[Complex64]) -> Map {
@@ -258,7 +323,7 @@ fn perturb(c: &ContinuumHandle, opts: &Map) -> ScriptResult<()> {
     };
     let pop = opts.get("population").map(population).transpose()?;
     lift(
-        c.lock()
+        c.lock_mut()?
             .perturb(&b, shape, [axis.x, axis.y, axis.z], mode, amplitude, pop),
     )
 }
@@ -328,6 +393,9 @@ pub fn register(engine: &mut Engine) {
             run(c, number("run(seconds)", &t)?)
         })
         .register_get("time", |c: &mut ContinuumHandle| c.lock().time())
+        .register_fn("copy", |c: &mut ContinuumHandle| {
+            ContinuumHandle::new(c.lock().clone())
+        })
         .register_get("stats", |c: &mut ContinuumHandle| {
             let st = *c.lock().stats();
             let mut m = Map::new();
@@ -414,12 +482,12 @@ const TWO: &str = "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[
-    doc_entry!("continuum", "continuum", "continuum(s) -> Continuum\ncontinuum(s, #{ grid, orientations, core, width, phases, tol })", "The kinetic theory of the averaged model for scene s's swimmers: one distribution f_p(x, n) per phase population in s's periodic box, moved by the mean field that the averaged pair terms (I, J, K, L, s.coefficients) give when summed over the distribution, and by the rigid dumbbells' diffusion when s.temperature > 0. It starts from the swimmers smoothed by a Gaussian of the given width (m; default one cell), as s.field smooths them. Pairs closer than core (m; default one length l) or beyond s's cutoff (as in the particle runs) are left out. grid: cells per axis (a number or [nx, ny, nz], default 16, at most 32768 cells); orientations: harmonic degree L of the orientation basis (2-8, default 4); phases: bin the phases into this many populations (default: one per distinct phase, at most 16); tol: the time stepping's tolerance relative to the structure (default 1e-6). One swimmer kind (equal radii, length, amplitude, omega). Every pair term carries sin(phi_p - phi_q): one population, or phases spread evenly, has no mean-field motion.", TWO),
+    doc_entry!("continuum", "continuum", "continuum(s) -> Continuum\ncontinuum(s, #{ grid, orientations, core, width, phases, tol })\nc.copy() -> Continuum", "The kinetic theory of the averaged model for scene s's swimmers: one distribution f_p(x, n) per phase population in s's periodic box, moved by the mean field that the averaged pair terms (I, J, K, L, s.coefficients) give when summed over the distribution, and by the rigid dumbbells' diffusion when s.temperature > 0. It starts from the swimmers smoothed by a Gaussian of the given width (m; default one cell; from a quarter of the largest cell side to half the box's longest side), as s.field smooths them. Pairs closer than core (m; default one length l; from l/4 up to the cutoff: the pair terms are the leading terms of an expansion in l/D for swimmers far apart, and closer than l/4 they describe no pair the particles have) or beyond s's cutoff (as in the particle runs) are left out. grid: cells per axis (a number or [nx, ny, nz], 4 or more per axis, at most 32768 cells, default 16); orientations: harmonic degree L of the orientation basis (2-8, default 4); phases: bin the phases into this many populations (1-16; default: one per distinct phase, at most 16); tol: the time stepping's tolerance relative to the structure (1e-10 <= tol < 1, default 1e-6). One swimmer kind (equal radii, length, amplitude, omega). Every pair term carries sin(phi_p - phi_q): one population, or phases spread evenly, has no mean-field motion. A continuum runs (c.run_periods(n), c.run(seconds)) up to 1e9 stroke periods, as a scene. c.copy() is an independent copy (same state); `let d = c;` would name the same continuum.", TWO),
     doc_entry!("counts", "continuum", "c.counts() -> array", "The number of swimmers in each population (the integral of its density): conserved by the dynamics to round-off.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(c.counts());"),
     doc_entry!("populations", "continuum", "c.populations -> array", "The phase populations: #{ phase (rad), swimmers (how many the scene had) } each, in the order fields and modes number them.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(c.populations);"),
-    doc_entry!("mode", "continuum", "c.mode(kind, [nx, ny, nz]) -> map\nc.mode(kind, [nx, ny, nz], population) -> map\ns.mode(kind, [nx, ny, nz]) -> map\ns.mode(kind, [nx, ny, nz], #{ phase }) -> map", "The Fourier amplitude at box wave vector k = 2 pi n / L of the swimmers' density (kind \"density\": sum_j exp(-i k.R_j)), polarization (sum_j N_j exp(-i k.R_j)) or nematic tensor (sum_j (3 N_j N_j - I)/2 exp(-i k.R_j), row by row): the integral of rho, rho Pi or rho Q times exp(-i k.x) for a continuum, the sum over the swimmers (of one phase, if given) for a scene, so the two compare directly. #{ re: [...], im: [...], abs }.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(s.mode(\"density\", [1, 0, 0]).abs); print(c.mode(\"density\", [1, 0, 0]).abs);"),
+    doc_entry!("mode", "continuum", "c.mode(kind, [nx, ny, nz]) -> map\nc.mode(kind, [nx, ny, nz], population) -> map\ns.mode(kind, [nx, ny, nz]) -> map\ns.mode(kind, [nx, ny, nz], #{ phase }) -> map", "The Fourier amplitude at box wave vector k = 2 pi n / L of the swimmers' density (kind \"density\": sum_j exp(-i k.R_j)), polarization (sum_j N_j exp(-i k.R_j)) or nematic tensor (sum_j (3 N_j N_j - I)/2 exp(-i k.R_j), row by row): the integral of rho, rho Pi or rho Q times exp(-i k.x) for a continuum, the sum over the swimmers (of one phase, if given: one the swimmers have) for a scene, so the two compare directly. #{ re: [...], im: [...], abs }. A continuum holds the modes its grid keeps against aliasing, |n| < cells/3 per axis (|n| <= 1 on 4 cells, 2 on 8, 5 on 16); a scene's modes go to 1e9 per axis (beyond, f64 rounds the phase 2 pi n.x/L by more than 1e-6 rad).", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(s.mode(\"density\", [1, 0, 0]).abs); print(c.mode(\"density\", [1, 0, 0]).abs);"),
     doc_entry!("wave_vector", "continuum", "c.wave_vector([nx, ny, nz]) -> array", "The box wave vector 2 pi n / L (1/m) of mode n.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(c.wave_vector([1, 0, 0]));"),
     doc_entry!("growth_rates", "continuum", "c.growth_rates(k) -> array\nc.growth_rates(k, #{ state: \"isotropic\" | \"polar\", polarization: [x, y, z] })", "Linear stability of a homogeneous state at each population's mean density: the eigenvalues sigma = rate + i frequency (1/s) of the operator linearised about it at wave vector k (1/m, any, e.g. c.wave_vector([1, 0, 0])), fastest growing first, each #{ rate, frequency, degree (the harmonic with most of the mode: 0 density, 1 polarization, 2 nematic), population }. States: isotropic (default), or polar rho(1 + 3 P.n)/4pi with |P| <= 1/3 (at temperature 0 only: noise makes it decay). Both are stationary (neither makes a mean field of its own); the harmonics of degree <= 2 are exact at any orientations >= 2, higher ones are carried along.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(#{ a1: 1.1e-6, a2: 0.56e-6 }), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(#{ a1: 1.1e-6, a2: 0.56e-6 }), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(c.growth_rates(c.wave_vector([0, 0, 1]), #{ state: \"polar\", polarization: [0, 0, 0.3] })[0]);"),
-    doc_entry!("perturb", "continuum", "c.perturb(#{ state, polarization, shape, axis, mode, amplitude, population })", "Set the continuum to a homogeneous state (as growth_rates takes it; default isotropic) at each population's mean density plus a plane wave cos(k.x) at box mode (default [1, 0, 0]) of relative amplitude (default 0.01) in the density (shape \"density\", default), the polarization along axis (\"polarization\": <N> gains amplitude * axis) or the nematic order along axis (\"nematic\": Q gains amplitude * (3 axis axis - I)/2), in one population or all (default). To prepare a comparison with particles (c.sample).", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); c.perturb(#{ shape: \"nematic\", axis: [0, 0, 1], amplitude: 0.2 }); print(c.mode(\"nematic\", [1, 0, 0]).abs);"),
+    doc_entry!("perturb", "continuum", "c.perturb(#{ state, polarization, shape, axis, mode, amplitude, population })", "Set the continuum to a homogeneous state (as growth_rates takes it; default isotropic) at each population's mean density plus a plane wave cos(k.x) at box mode (default [1, 0, 0]; not [0, 0, 0], the mean, which would change the conserved numbers; within the modes the grid keeps, as c.mode) of relative amplitude (default 0.01) in the density (shape \"density\", default), the polarization along axis (\"polarization\": <N> gains amplitude * axis) or the nematic order along axis (\"nematic\": Q gains amplitude * (3 axis axis - I)/2), in one population (an index of c.populations) or all (default). The amplitude keeps f >= 0 everywhere: about the isotropic state |amplitude| <= 1 (density), 1/3 (polarization), 1/5 (nematic); about a polar state less (1 - 3|P| for the density); a larger one is refused with its bound. A refused call leaves the continuum as it was. To prepare a comparison with particles (c.sample).", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); c.perturb(#{ shape: \"nematic\", axis: [0, 0, 1], amplitude: 0.2 }); print(c.mode(\"nematic\", [1, 0, 0]).abs);"),
     doc_entry!("sample", "continuum", "c.sample(s, n, seed) -> int\nc.sample(s, n, seed, #{ gap })", "Add n swimmers of the continuum's kind to scene s (which has the continuum's box) drawn from its distribution: a population in proportion to its number (with its phase), a cell in proportion to the density there, a place uniform in the cell, an orientation from f at the cell. Draws that would bring spheres closer than gap (as add_random) are drawn again. Returns the new count; all or nothing.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); c.perturb(#{ amplitude: 0.5 }); let t = scene(); t.model = \"averaged\"; t.box = [60e-6, 60e-6, 60e-6]; print(c.sample(t, 40, 7));"),
 ];

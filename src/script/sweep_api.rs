@@ -4,11 +4,12 @@
 //! the results come back in the order of `params`, and the first failing call (in that order)
 //! is the error, naming its parameter. Ctrl-C stops every call between statements.
 //!
-//! A scene that every call reaches (captured by the closure, or given in more than one
-//! parameter) is shared by calls running at once: they may read it (properties, observe, copy,
-//! save) but not change it, which would race and make the results change from run to run; a
-//! change is an error naming the fix (build the scene in the call, or change a copy).
+//! A scene or continuum that every call reaches (captured by the closure, or given in more than
+//! one parameter) is shared by calls running at once: they may read it (properties, observe,
+//! copy, save) but not change it, which would race and make the results change from run to run;
+//! a change is an error naming the fix (build it in the call, or change a copy).
 
+use super::continuum_api::ContinuumHandle;
 use super::convert::{script_error, ScriptResult};
 use super::doc::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
@@ -31,32 +32,67 @@ fn sweep(
     f: FnPtr,
     threads: Option<usize>,
 ) -> ScriptResult<Array> {
-    // Scenes the calls share: the closure's captures, and any reached from two parameters.
-    let mut shared = Vec::new();
+    // Scenes and continuums the calls share: the closure's captures, and any reached from two
+    // parameters.
+    let mut shared = Reached::default();
     if params.len() > 1 {
         for v in f.curry() {
-            scenes_in(v, &mut shared, 0);
+            reached_from(v, &mut shared, 0);
         }
-        let mut seen: Vec<SceneHandle> = Vec::new();
+        let mut seen = Reached::default();
         for p in &params {
-            let mut here = Vec::new();
-            scenes_in(p, &mut here, 0);
-            for h in here {
-                if seen.iter().any(|s| s.same(&h)) {
-                    shared.push(h);
+            let mut here = Reached::default();
+            reached_from(p, &mut here, 0);
+            for h in here.scenes {
+                if seen.scenes.iter().any(|s| s.same(&h)) {
+                    shared.scenes.push(h);
                 } else {
-                    seen.push(h);
+                    seen.scenes.push(h);
+                }
+            }
+            for h in here.continuums {
+                if seen.continuums.iter().any(|c| c.same(&h)) {
+                    shared.continuums.push(h);
+                } else {
+                    seen.continuums.push(h);
                 }
             }
         }
     }
-    let mut unique: Vec<SceneHandle> = Vec::new();
-    for h in shared {
-        if !unique.iter().any(|u| u.same(&h)) {
-            unique.push(h);
+    let mut scenes: Vec<SceneHandle> = Vec::new();
+    for h in shared.scenes {
+        if !scenes.iter().any(|u| u.same(&h)) {
+            scenes.push(h);
         }
     }
-    let _shared = SceneHandle::share_in_sweep(unique);
+    let mut continuums: Vec<ContinuumHandle> = Vec::new();
+    for h in shared.continuums {
+        if !continuums.iter().any(|u| u.same(&h)) {
+            continuums.push(h);
+        }
+    }
+    let _scenes = SceneHandle::share_in_sweep(scenes);
+    let _continuums = ContinuumHandle::share_in_sweep(continuums);
+    // Captured scenes and continuums reach the calls as their handles, not as the captured
+    // variables: Rhai holds a captured variable's lock through a whole method call on it, so calls
+    // running at once would find it taken (its bare "Data race detected", after a few
+    // milliseconds) where the handle's own lock waits its turn, and the share refuses changes. (A
+    // call that assigns such a variable anew changes its own copy only.)
+    let mut f = f;
+    let curry: Vec<Dynamic> = f
+        .curry()
+        .iter()
+        .map(|v| {
+            let handle = v.read_lock::<SceneHandle>().is_some()
+                || v.read_lock::<ContinuumHandle>().is_some();
+            if v.is_shared() && handle {
+                v.flatten_clone()
+            } else {
+                v.clone()
+            }
+        })
+        .collect();
+    f.set_curry(curry);
     let store = ctx.store_data();
     let engine = ctx.engine();
     let call = |(k, p): (usize, &Dynamic)| -> Result<Dynamic, (usize, Box<EvalAltResult>)> {
@@ -92,22 +128,33 @@ fn sweep(
 /// Nesting deeper than this is not searched for scenes (values nest arrays, maps and closures).
 const MAX_DEPTH: usize = 32;
 
-/// The scenes `v` reaches: itself, a recorder's scene, and those in arrays, maps and the captures
-/// of closures.
-fn scenes_in(v: &Dynamic, out: &mut Vec<SceneHandle>, depth: usize) {
+/// The scenes and continuums a value reaches.
+#[derive(Default)]
+struct Reached {
+    scenes: Vec<SceneHandle>,
+    continuums: Vec<ContinuumHandle>,
+}
+
+/// The scenes and continuums `v` reaches: itself, a recorder's scene, and those in arrays, maps
+/// and the captures of closures.
+fn reached_from(v: &Dynamic, out: &mut Reached, depth: usize) {
     if depth > MAX_DEPTH {
         return;
     }
     if let Some(h) = v.read_lock::<SceneHandle>() {
-        out.push(h.clone());
+        out.scenes.push(h.clone());
+    } else if let Some(c) = v.read_lock::<ContinuumHandle>() {
+        out.continuums.push(c.clone());
     } else if let Some(r) = v.read_lock::<RecorderHandle>() {
-        out.push(r.scene.clone());
+        out.scenes.push(r.scene.clone());
     } else if let Some(a) = v.read_lock::<Array>() {
-        a.iter().for_each(|x| scenes_in(x, out, depth + 1));
+        a.iter().for_each(|x| reached_from(x, out, depth + 1));
     } else if let Some(m) = v.read_lock::<Map>() {
-        m.values().for_each(|x| scenes_in(x, out, depth + 1));
+        m.values().for_each(|x| reached_from(x, out, depth + 1));
     } else if let Some(f) = v.read_lock::<FnPtr>() {
-        f.curry().iter().for_each(|x| scenes_in(x, out, depth + 1));
+        f.curry()
+            .iter()
+            .for_each(|x| reached_from(x, out, depth + 1));
     }
 }
 
@@ -146,5 +193,5 @@ pub fn register(engine: &mut Engine) {
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[
-    doc_entry!("sweep", "scene", "sweep(params: array, f) -> array\nsweep(params: array, f, threads: int) -> array", "Call f(p) for every p of params on all cores (or on `threads` threads) and return the results in the order of params. Each call should build its own scene; results may be numbers, strings, arrays or maps. A scene every call reaches (captured by f, or given in more than one parameter) is shared by calls that run at once: they may read it (properties, observe, copy, save) but not change it (run, settings, recorders), which would race and make the results change from run to run; such a change is an error: build the scene inside f, or change a copy (|p| { let t = s.copy(); t.run_periods(p); t.time }). The first failing call is the error, naming its parameter. For clusters, run one process per parameter instead: swimlab run script.rhai --set D=10 (the book: Trajectories, sweeps and clusters).", "let r = sweep([1, 2, 3], |p| p * p); print(r);"),
+    doc_entry!("sweep", "scene", "sweep(params: array, f) -> array\nsweep(params: array, f, threads: int) -> array", "Call f(p) for every p of params on all cores (or on `threads` threads) and return the results in the order of params. Each call should build its own scene; results may be numbers, strings, arrays or maps. A scene or continuum every call reaches (captured by f, or given in more than one parameter) is shared by calls that run at once: they may read it (properties, observe, modes, copy, save, c.sample) but not change it (run, settings, recorders, c.perturb), which would race and make the results change from run to run; such a change is an error: build it inside f, or change a copy (|p| { let t = s.copy(); t.run_periods(p); t.time }). The first failing call is the error, naming its parameter. For clusters, run one process per parameter instead: swimlab run script.rhai --set D=10 (the book: Trajectories, sweeps and clusters).", "let r = sweep([1, 2, 3], |p| p * p); print(r);"),
 ];

@@ -255,21 +255,21 @@ pub struct Radial {
 
 impl Radial {
     /// Pairs from `core` to `cutoff` (m) with the cutoff's switch, resolved for wave numbers up
-    /// to `k_max` (1/m).
+    /// to `k_max` (1/m): Gauss-Legendre panels no wider than a quarter of their distance (the
+    /// integrand's D^{2−m} changes on the scale D) nor than 1/k_max (j_l(kD) oscillates on that
+    /// scale), split at the switch. Their number grows with log(cutoff/core) near the core and
+    /// with k_max·cutoff beyond, so the cost does not follow the core down.
     pub fn new(core: f64, cutoff: f64, k_max: f64) -> Self {
         let switch = CutoffSwitch::new(Some(cutoff));
         let (x, w) = gauss_legendre(8);
-        let width = (core / 4.0).min(1.0 / k_max.max(1e-300));
+        let step = 1.0 / k_max.max(1e-300);
         let mut edges = vec![core];
         for (a, b) in [
             (core, switch.inner().max(core)),
             (switch.inner().max(core), cutoff),
         ] {
             if b > a {
-                let panels = ((b - a) / width).ceil().max(1.0) as usize;
-                for p in 1..=panels {
-                    edges.push(a + (b - a) * p as f64 / panels as f64);
-                }
+                edges.extend(panel_edges(a, b, step));
             }
         }
         let mut nodes = Vec::new();
@@ -288,6 +288,11 @@ impl Radial {
         Radial { nodes, weights }
     }
 
+    /// The number of quadrature nodes (8 per panel).
+    pub fn nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
     /// R_lm(k) = ∫ D^{2−m} H(D) j_l(kD) dD for l = 0..=6, m = 3, 4, 5 (index m − 3).
     pub fn integrals(&self, k: f64) -> [[f64; 7]; 3] {
         let mut r = [[0.0; 7]; 3];
@@ -302,6 +307,21 @@ impl Radial {
         }
         r
     }
+}
+
+/// The panel ends after `a` up to `b` (m), `b` last: panels growing by a quarter of their
+/// start while that is below `step`, then equal ones no wider than `step`.
+fn panel_edges(a: f64, b: f64, step: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut e = a;
+    while e > 0.0 && 0.25 * e < step && 1.25 * e < b {
+        e *= 1.25;
+        out.push(e);
+    }
+    let panels = ((b - e) / step).ceil().max(1.0) as usize;
+    out.extend((1..=panels).map(|p| e + (b - e) * p as f64 / panels as f64));
+    *out.last_mut().expect("one panel at least") = b;
+    out
 }
 
 /// j_0..j_6 at x ≥ 0: the power series below x = 8 (all terms kept until they no longer change

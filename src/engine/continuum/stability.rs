@@ -12,7 +12,8 @@
 //! any L ≥ 2, and those of degree > 2 are 0 (they are carried along, never fed back).
 
 use super::kernel::{self, Radial};
-use super::{Operator, Population};
+use super::operator::Operator;
+use super::Population;
 use crate::engine::error::{invalid, Result};
 use nalgebra::DMatrix;
 use rustfft::num_complex::Complex64;

@@ -26,7 +26,7 @@ pub use philox::StepDraws;
 pub use rk4::Rk4;
 pub use rosenbrock::Rosenbrock;
 pub use sde::Platen;
-pub use spec::{Direct, IntegratorSpec, Method, METHODS};
+pub use spec::{check_tolerance, Direct, Horizon, IntegratorSpec, Method, METHODS, MIN_DRIFT_TOL};
 pub use stroboscopic::{Stroboscopic, MIN_MACRO};
 pub use suspension::Suspension;
 pub use system::{

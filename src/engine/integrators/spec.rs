@@ -1,4 +1,5 @@
-//! The user's choice of integrator, as saved with a scene.
+//! The user's choice of integrator, as saved with a scene, and the checks every run-like call
+//! (a scene's, a continuum's) makes of its tolerance and of its end.
 
 use super::{Dopri5, Euler, Platen, Rk4, Rosenbrock, Stepper};
 use crate::engine::error::invalid;
@@ -359,14 +360,20 @@ impl IntegratorSpec {
     }
 }
 
+/// The least tolerance relative to a drift or a structure (stroboscopic averaging, `auto`, the
+/// suspension method, a continuum): below, round-off rather than the error it bounds sets it.
+pub const MIN_DRIFT_TOL: f64 = 1e-10;
+
+/// The least relative tolerance of an adaptive direct method (dopri5, rosw).
+const MIN_RTOL: f64 = 1e-14;
+
 /// A tolerance relative to the drift: 1e-10 ≤ tol < 1 (below, the samples' round-off is larger
 /// than what is asked).
 fn check_drift_tol(method: &str, tol: f64) -> Result<f64> {
     check_tolerance(
-        method,
-        "tol",
+        &format!("{method}(tol): tol"),
         tol,
-        1e-10,
+        MIN_DRIFT_TOL,
         "the samples' round-off is larger than what is asked",
     )
 }
@@ -374,23 +381,74 @@ fn check_drift_tol(method: &str, tol: f64) -> Result<f64> {
 /// An adaptive method's tolerance: 1e-14 ≤ rtol < 1.
 fn check_rtol(method: &str, rtol: f64) -> Result<f64> {
     check_tolerance(
-        method,
-        "rtol",
+        &format!("{method}(rtol): rtol"),
         rtol,
-        1e-14,
+        MIN_RTOL,
         "the error estimate is round-off",
     )
 }
 
-/// `method(name)`'s tolerance `value`, positive, in [min, 1); `why` says what fails below min.
-fn check_tolerance(method: &str, name: &str, value: f64, min: f64, why: &str) -> Result<f64> {
-    require_positive(&format!("{method}({name}): {name}"), value, "dimensionless")?;
+/// The one check of a run's tolerance (a scene's integrator, a continuum's): `value` positive, in
+/// [`min`, 1); `what` names it in the message, `why` says what fails below `min`.
+pub fn check_tolerance(what: &str, value: f64, min: f64, why: &str) -> Result<f64> {
+    require_positive(what, value, "dimensionless")?;
     if !(min..1.0).contains(&value) {
         return Err(invalid!(
-            "{method}({name}): {name} must lie in [{min:e}, 1) (below {min:e} {why}), got {value:e}"
+            "{what} must lie in [{min:e}, 1) (below {min:e} {why}), got {value:e}"
         ));
     }
     Ok(value)
+}
+
+/// The latest time a state that runs may hold (a scene's, a continuum's): a number of its
+/// longest stroke period, beyond which f64 no longer resolves the stroke. Every run-like call
+/// checks its end against it before it starts ([`Horizon::check`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Horizon<'a> {
+    /// What holds the state, in the message ("a scene").
+    pub holder: &'a str,
+    /// The latest time it may hold (s).
+    pub latest: f64,
+    /// `latest` in stroke periods.
+    pub max_periods: f64,
+    /// The common stroke period (s), if there is one: times are then shown in periods too.
+    pub period: Option<f64>,
+    /// What else fails beyond (", and a saved scene would not load"), or "".
+    pub beyond: &'a str,
+    /// The fix besides a shorter run ("continue in a new scene from time 0").
+    pub restart: &'a str,
+}
+
+impl Horizon<'_> {
+    /// Refuse a run from `now` to `end` (s) that ends past the latest time, or at no time at all
+    /// (NaN, inf); an end at or before `now` is no run and passes.
+    pub fn check(&self, now: f64, end: f64) -> Result<()> {
+        if end.is_nan() {
+            return Err(invalid!(
+                "a run of {} must end at a time, and this one would end at t = NaN s; give its length as a number",
+                self.holder
+            ));
+        }
+        if end <= now || end <= self.latest {
+            return Ok(());
+        }
+        let periods = |t: f64| {
+            self.period
+                .map_or(String::new(), |p| format!(" ({:.6e} periods)", t / p))
+        };
+        Err(invalid!(
+            "this run would end at t = {end:.6e} s{}, past the latest time {} may hold, {:.6e} s{} ({:e} stroke periods: beyond, f64 no longer resolves the stroke{}); run at most {:.6e} s{} more, or {}",
+            periods(end),
+            self.holder,
+            self.latest,
+            periods(self.latest),
+            self.max_periods,
+            self.beyond,
+            self.latest - now,
+            periods(self.latest - now),
+            self.restart,
+        ))
+    }
 }
 
 impl fmt::Display for IntegratorSpec {
