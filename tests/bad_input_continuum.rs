@@ -6,84 +6,14 @@
 //! `swimlab` process under a time limit, so a hang fails the test instead of stalling it, and a
 //! panic shows as the "internal error" the script boundary turns it into.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use crate::common::cli;
 
-/// Well above any case's real cost (a continuum on 4³ cells builds and runs a period in well
-/// under a second), far below what the hangs these cases once were would take (never returning,
-/// or 11 GB and counting).
-const LIMIT: Duration = Duration::from_secs(60);
-
-/// A fresh folder for one case.
-fn case_dir() -> PathBuf {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static N: AtomicU64 = AtomicU64::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "swimlab-bad-continuum-{}/case-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst)
-    ));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run `swimlab run` on `script` in `cwd` to completion within [`LIMIT`].
-fn run_in(script: &str, cwd: &Path) -> Output {
-    let file = cwd.join("case.rhai");
-    std::fs::write(&file, script).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
-        .args(["run", file.to_str().unwrap()])
-        .current_dir(cwd)
-        .env("SWIMLAB_PROGRESS", "0")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start swimlab");
-    let start = Instant::now();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            return child.wait_with_output().unwrap();
-        }
-        if start.elapsed() > LIMIT {
-            let _ = child.kill();
-            panic!("did not finish within {LIMIT:?} (a hang):\n{script}");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
-
-/// Run `script`; check the exit code, that the output holds every fragment, and that no panic,
-/// Rust text, Rhai's own data-race text or a NaN surfaced.
+/// Run `script` ([`cli::case`]); also check that neither Rhai's own data-race text nor a NaN
+/// surfaced.
 #[track_caller]
 fn case(script: &str, fragments: &[&str], code: i32) -> String {
-    let out = run_in(script, &case_dir());
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(code),
-        "exit code of:\n{script}\n---\n{text}"
-    );
-    for f in fragments {
-        assert!(
-            text.contains(f),
-            "missing {f:?} for:\n{script}\n---\n{text}"
-        );
-    }
-    for bad in [
-        "internal error",
-        "panicked",
-        "swimlab::",
-        "Data race",
-        "Function not found",
-        "NaN,",
-        "inf,",
-    ] {
+    let text = cli::case(script, fragments, code);
+    for bad in ["Data race", "NaN,", "inf,"] {
         assert!(!text.contains(bad), "{bad:?} for:\n{script}\n---\n{text}");
     }
     text

@@ -9,6 +9,7 @@ mod common;
 mod architecture;
 mod averaged_model;
 mod bad_input;
+mod bad_input_continuum;
 mod bad_input_messages;
 mod bad_input_round_two;
 mod bad_input_runs;
