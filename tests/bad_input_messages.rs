@@ -114,7 +114,7 @@ fn properties_are_named_in_script_words() {
 fn a_data_race_is_explained() {
     let text = case(
         "let a = [1, 2];\nlet f = |x| { a.push(x); x };\nprint(a.map(f));",
-        &["was changed while it was in use", "change a copy"],
+        &["was in use by one call while another needed it", "a copy"],
         1,
     );
     assert!(!text.contains("Data race detected"), "{text}");

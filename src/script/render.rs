@@ -280,9 +280,9 @@ fn module_not_found(m: &str) -> String {
     )
 }
 
-/// Rhai's "Data race detected": a variable a closure captured was changed while it was in use,
-/// by calls of the closure that run at once (a sweep's) or by the closure called from inside a
-/// method of that same variable.
+/// Rhai's "Data race detected": a variable a closure captured was held by one use (a method
+/// call on it) while another needed it: calls of the closure that run at once (a sweep's), or
+/// the closure called from inside a method of that same variable.
 fn data_race(name: &str) -> String {
     let what = if name.is_empty() {
         "a variable that a closure captured".to_string()
@@ -290,7 +290,7 @@ fn data_race(name: &str) -> String {
         format!("a variable that a closure captured ({name})")
     };
     format!(
-        "{what} was changed while it was in use: by calls of the closure that run at once (a sweep's calls share what their closure captures), or by the closure called while a method of that same variable runs; calls may read what they share, not change it: build the value inside the closure, or change a copy there (let t = s.copy(); ...)"
+        "{what} was in use by one call while another needed it: calls of the closure that run at once share what it captures (a sweep's calls), and a closure called while a method of that same variable runs finds it held; build the value inside the closure, or give each call a copy (let t = s.copy(); ...)"
     )
 }
 
