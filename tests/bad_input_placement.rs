@@ -1,14 +1,16 @@
-//! Random placements that cannot succeed, tried as a hostile new user would: a placement is
-//! refused before it starts when it cannot fit (one estimate of what random sequential addition
-//! places, shared by `add_random` in a box, in open space and `c.sample`), the attempts that start
-//! are bounded by the room they have, and a wall in the way is named. Script cases run in their
-//! own `swimlab` process under a time limit, so a hang fails the test instead of stalling it.
+//! Random placements that cannot succeed, and observables without a value, tried as a hostile new
+//! user would: a placement is refused before it starts when it cannot fit (one estimate of what
+//! random sequential addition places, shared by `add_random` in a box, in open space and
+//! `c.sample`), the attempts that start are bounded by the room they have, a wall in the way is
+//! named, and no observable returns inf or NaN as a value. Script cases run in their own `swimlab`
+//! process under a time limit, so a hang fails the test instead of stalling it.
 
 use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 use swimlab::engine::build::{place_apart, rsa_fill, DRAWS_PER_BODY};
-use swimlab::engine::{Dumbbell, Model, Scene};
+use swimlab::engine::wall::Wall;
+use swimlab::engine::{Dumbbell, Model, Observable, Scene};
 
 /// Well above any case's real cost (a refusal, or a placement of a few hundred swimmers), far
 /// below the minutes to hours the refused placements once drew for.
@@ -250,6 +252,131 @@ fn a_wall_in_the_way_of_a_placement_is_named() {
         &[],
         0,
     );
+}
+
+/// With no swimmers, the scene-wide observables that have no value refuse, as `height(0)` does,
+/// instead of returning inf or 0; a recorder of them may still be set up before the swimmers.
+#[test]
+fn scene_wide_observables_without_swimmers_refuse() {
+    for o in [
+        "wall_gap()",
+        "min_gap()",
+        "polarization()",
+        "nematic()",
+        "msd()",
+        "mean_speed()",
+    ] {
+        let name = o.trim_end_matches("()");
+        case(
+            &format!("let s = scene();\ns.wall = #{{ z: 0.0 }};\ns.observe({o});"),
+            &[
+                &format!("{name} is "),
+                "this scene has no swimmers",
+                "add swimmers first",
+            ],
+            &[],
+            1,
+        );
+    }
+    case(
+        "let s = scene();\ns.wall = #{ z: 0.0 };\nlet r = s.record([wall_gap(), polarization()], at_end());\ns.add(dumbbell(#{ center: [0, 0, 5e-6] }));\ns.run_periods(1);\nprint(r.rows.len());\nprint(r.rows[0][\"wall_gap\"] > 0.0);",
+        &["1\ntrue"],
+        &[],
+        0,
+    );
+}
+
+/// Two of the paper's swimmers 10 µm apart above a wall, at room temperature.
+fn pair_above_a_wall() -> Scene {
+    let mut s = Scene::new();
+    let d = Dumbbell::default();
+    s.add(
+        d,
+        nalgebra::Vector3::new(0.0, 0.0, 5e-6),
+        nalgebra::Vector3::x(),
+    )
+    .unwrap();
+    s.add(
+        Dumbbell { phase: 1.0, ..d },
+        nalgebra::Vector3::new(0.0, 10e-6, 5e-6),
+        nalgebra::Vector3::y(),
+    )
+    .unwrap();
+    s.set_wall(Some(Wall::at(0.0).unwrap())).unwrap();
+    s.set_temperature(300.0).unwrap();
+    s
+}
+
+/// A Péclet number at a temperature whose diffusion coefficient rounds to 0 is refused, naming the
+/// temperature and one to use, instead of inf.
+#[test]
+fn a_peclet_number_beyond_f64_is_refused() {
+    let mut s = pair_above_a_wall();
+    s.set_temperature(1e-320).unwrap();
+    let e = Observable::Peclet(0, 1)
+        .evaluate(&s)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the Peclet number at 1e-320 K") && e.contains("300 K"),
+        "{e}"
+    );
+}
+
+/// Every observable of a legal scene (two swimmers above a wall, at a temperature) is finite.
+#[test]
+fn every_observable_of_a_legal_scene_is_finite() {
+    use swimlab::engine::fields::{FieldKind, FieldSpec, FieldStat};
+    let s = pair_above_a_wall();
+    let axis = nalgebra::Vector3::x();
+    let mut all = vec![
+        Observable::CenterH(0),
+        Observable::CenterG(0),
+        Observable::Dir(0),
+        Observable::Length(0),
+        Observable::Tension(0),
+        Observable::PairMean(0, 1, axis),
+        Observable::PairSeparation(0, 1, axis),
+        Observable::Q(0, 1),
+        Observable::DistanceH(0, 1),
+        Observable::DeltaQ(0, 1),
+        Observable::DeltaDistanceH(0, 1),
+        Observable::Polarization,
+        Observable::Nematic,
+        Observable::MinGap,
+        Observable::WallGap,
+        Observable::Height(0),
+        Observable::WallAngle(0),
+        Observable::MeanSpeed,
+        Observable::Msd,
+        Observable::Peclet(0, 1),
+        Observable::PairDistances {
+            bins: 4,
+            r_max: 20e-6,
+        },
+    ];
+    for kind in [
+        FieldKind::Density,
+        FieldKind::Polarization,
+        FieldKind::Nematic,
+    ] {
+        for stat in [
+            FieldStat::Mean,
+            FieldStat::Variance,
+            FieldStat::Max,
+            FieldStat::Min,
+        ] {
+            all.push(Observable::Field {
+                kind,
+                stat,
+                spec: FieldSpec::default(),
+            });
+        }
+    }
+    for o in all {
+        let v = o.evaluate(&s).unwrap();
+        assert!(v.iter().all(|x| x.is_finite()), "{o}: {v:?}");
+    }
 }
 
 /// The estimate lies just above what random sequential addition places in its draws: the paper's
