@@ -161,6 +161,13 @@ fn placements_that_cannot_fit_are_refused_before_they_start() {
             0,
         );
     }
+    // None are placed without a word, by volume fraction too (a cube of side 0).
+    case(
+        "let s = scene();\nprint(`count ${s.add_random(dumbbell(), 0, 0.01, 1)}`);",
+        &["count 0"],
+        &["box side"],
+        0,
+    );
     // Swimmers already in the box take their room.
     case(
         &format!("{in_box}s.add_random(dumbbell(), 10000, 1);\ntry {{ s.add_random(dumbbell(), 10000, 2); }} catch (e) {{ print(e); }}\nprint(`count ${{s.count}}`);"),

@@ -105,6 +105,10 @@ pub fn random_suspension_apart(
     seed: u64,
     gap: Option<f64>,
 ) -> Result<()> {
+    // No swimmers need no room (a volume fraction gives them a cube of side 0).
+    if n == 0 {
+        return Ok(());
+    }
     for side in sides {
         require_positive("box side", side, "m")?;
     }
