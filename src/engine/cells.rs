@@ -11,6 +11,45 @@
 
 use super::periodic::PeriodicBox;
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A fast hash of cell keys (a multiply and a rotation per word, as rustc's own `FxHasher`): the
+/// keys are small integers the program makes itself, so the default hasher's resistance to
+/// chosen collisions buys nothing, and a search hashes up to 27 keys a point.
+#[derive(Debug, Clone, Copy, Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        // A key's integers come as their bytes, one word at a time.
+        let mut words = bytes.chunks_exact(8);
+        for w in &mut words {
+            self.write_u64(u64::from_le_bytes(w.try_into().unwrap_or_default()));
+        }
+        for b in words.remainder() {
+            self.write_u64(u64::from(*b));
+        }
+    }
+
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
+    }
+
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+}
+
+/// Maps keyed by cell.
+type CellTable<V> = HashMap<[i64; 3], V, BuildHasherDefault<CellHasher>>;
 
 /// How points are binned: cubic cells of side `size`, or in a periodic box its tiling by
 /// n_d = ⌊L_d/size⌋ cells of side L_d/n_d ≥ size per axis.
@@ -43,27 +82,36 @@ impl Binning {
         }
     }
 
-    /// The 27 cells around the cell `key` (wrapped in a box, each once), in a fixed order.
-    fn around(&self, key: [i64; 3], mut visit: impl FnMut([i64; 3])) {
+    /// The 27 cells around the cell `key` (wrapped in a box, each once), in a fixed order, until
+    /// `visit` returns false.
+    fn around(&self, key: [i64; 3], mut visit: impl FnMut([i64; 3]) -> bool) {
         let [i, j, k] = key;
+        // Fewer than 3 cells along an axis: the wrapped neighbours repeat.
+        let repeats = self.periodic.is_some_and(|(_, n)| n.iter().any(|&n| n < 3));
         let mut seen: Vec<[i64; 3]> = Vec::new();
         for di in -1..=1 {
             for dj in -1..=1 {
                 for dk in -1..=1 {
                     let mut cell = [i + di, j + dj, k + dk];
                     if let Some((_, n)) = self.periodic {
+                        // A key lies in 0..n, so its neighbours are at most one period out.
                         for (c, n) in cell.iter_mut().zip(n) {
-                            *c = c.rem_euclid(n);
+                            if *c < 0 {
+                                *c += n;
+                            } else if *c >= n {
+                                *c -= n;
+                            }
                         }
-                        // Fewer than 3 cells along an axis: the wrapped neighbours repeat.
-                        if n.iter().any(|&n| n < 3) {
+                        if repeats {
                             if seen.contains(&cell) {
                                 continue;
                             }
                             seen.push(cell);
                         }
                     }
-                    visit(cell);
+                    if !visit(cell) {
+                        return;
+                    }
                 }
             }
         }
@@ -81,7 +129,7 @@ pub struct CellGrid {
     /// The point indices, cell by cell (ascending within a cell).
     pub order: Vec<u32>,
     /// Each occupied cell's run `start..end` in `order`.
-    runs: HashMap<[i64; 3], (u32, u32)>,
+    runs: CellTable<(u32, u32)>,
 }
 
 impl CellGrid {
@@ -101,7 +149,7 @@ impl CellGrid {
         let mut grid = CellGrid {
             binning: Binning::new(size, periodic),
             order: (0..x.len() as u32).collect(),
-            runs: HashMap::new(),
+            runs: CellTable::default(),
         };
         let keys: Vec<[i64; 3]> = (0..x.len())
             .map(|i| grid.binning.key(x[i], y[i], z[i]))
@@ -127,6 +175,7 @@ impl CellGrid {
             if let Some(&r) = self.runs.get(&cell) {
                 out.push(r);
             }
+            true
         });
     }
 }
@@ -139,28 +188,91 @@ impl CellGrid {
 #[derive(Debug, Clone, Default)]
 pub struct CellMap {
     binning: Binning,
-    cells: HashMap<[i64; 3], Vec<(u32, [f64; 3])>>,
+    cells: Cells,
 }
+
+/// A cell's points: ids and positions.
+type Points = Vec<(u32, [f64; 3])>;
+
+/// The cells of a [`CellMap`]: an array of a box's cells ([`CellMap::for_points`]), or the occupied
+/// ones by key.
+#[derive(Debug, Clone)]
+enum Cells {
+    Dense(Vec<Points>),
+    Sparse(CellTable<Points>),
+}
+
+impl Default for Cells {
+    fn default() -> Self {
+        Cells::Sparse(CellTable::default())
+    }
+}
+
+/// Most cells a box's [`CellMap`] holds as an array (24 MB of empty cells).
+const MAX_DENSE_CELLS: i64 = 1 << 20;
 
 impl CellMap {
     /// An empty map of cells of side `size` (m, positive and finite), in `periodic` if any.
     pub fn new(size: f64, periodic: Option<&PeriodicBox>) -> Self {
         CellMap {
             binning: Binning::new(size, periodic),
-            cells: HashMap::new(),
+            cells: Cells::default(),
+        }
+    }
+
+    /// [`CellMap::new`] for about `points` points: in a box of not many more cells than that
+    /// (at most [`MAX_DENSE_CELLS`]), an array of all its cells, which a search reads by index
+    /// instead of by key.
+    pub fn for_points(size: f64, periodic: Option<&PeriodicBox>, points: usize) -> Self {
+        let mut map = Self::new(size, periodic);
+        let limit = (8 * points as i64)
+            .saturating_add(4096)
+            .min(MAX_DENSE_CELLS);
+        if let Some((_, n)) = map.binning.periodic {
+            let cells = n.iter().try_fold(1i64, |a, &k| a.checked_mul(k));
+            if let Some(c) = cells.filter(|&c| c <= limit) {
+                map.cells = Cells::Dense(vec![Vec::new(); c as usize]);
+            }
+        }
+        map
+    }
+
+    /// The index of cell `key` in a dense map (keys in a box lie in 0..n per axis).
+    fn index(&self, key: [i64; 3]) -> usize {
+        let n = self.binning.periodic.map_or([0; 3], |(_, n)| n);
+        (key[0] + n[0] * (key[1] + n[1] * key[2])) as usize
+    }
+
+    fn cell(&self, key: [i64; 3]) -> Option<&Points> {
+        match &self.cells {
+            Cells::Dense(all) => all.get(self.index(key)),
+            Cells::Sparse(map) => map.get(&key),
+        }
+    }
+
+    fn cell_mut(&mut self, key: [i64; 3]) -> &mut Points {
+        let at = self.index(key);
+        match &mut self.cells {
+            Cells::Dense(all) => &mut all[at],
+            Cells::Sparse(map) => map.entry(key).or_default(),
         }
     }
 
     /// Add point `id` at (x, y, z).
     pub fn insert(&mut self, x: f64, y: f64, z: f64, id: u32) {
         let key = self.binning.key(x, y, z);
-        self.cells.entry(key).or_default().push((id, [x, y, z]));
+        self.cell_mut(key).push((id, [x, y, z]));
     }
 
     /// Take point `id` at (x, y, z) out (where it was inserted).
     pub fn remove(&mut self, x: f64, y: f64, z: f64, id: u32) {
         let key = self.binning.key(x, y, z);
-        if let Some(ids) = self.cells.get_mut(&key) {
+        let at = self.index(key);
+        let ids = match &mut self.cells {
+            Cells::Dense(all) => all.get_mut(at),
+            Cells::Sparse(map) => map.get_mut(&key),
+        };
+        if let Some(ids) = ids {
             ids.retain(|p| p.0 != id);
         }
     }
@@ -176,11 +288,10 @@ impl CellMap {
     ) -> bool {
         let mut go_on = true;
         self.binning.around(self.binning.key(x, y, z), |cell| {
-            if go_on {
-                if let Some(ids) = self.cells.get(&cell) {
-                    go_on = ids.iter().all(|&(id, p)| visit(id, p));
-                }
+            if let Some(ids) = self.cell(cell) {
+                go_on = ids.iter().all(|&(id, p)| visit(id, p));
             }
+            go_on
         });
         go_on
     }

@@ -223,6 +223,21 @@ impl Observable {
         Ok(())
     }
 
+    /// What a scene-wide observable that has no value without swimmers measures, or `None`
+    /// (the one-swimmer and pair observables name their swimmers; a histogram of no pairs is
+    /// all zeros; a field refuses an empty scene itself).
+    fn over_the_swimmers(&self) -> Option<&'static str> {
+        match self {
+            Observable::Polarization | Observable::Nematic => {
+                Some("an order of the swimmers' orientations")
+            }
+            Observable::MeanSpeed | Observable::Msd => Some("an average over the swimmers"),
+            Observable::MinGap => Some("the smallest gap between two spheres of the swimmers"),
+            Observable::WallGap => Some("the smallest gap between the wall and a swimmer's sphere"),
+            _ => None,
+        }
+    }
+
     /// The value now (1 or 3 components).
     pub fn evaluate(&self, s: &Scene) -> Result<Vec<f64>> {
         let mut ws = Workspace::default();
@@ -235,6 +250,15 @@ impl Observable {
     /// itself is never changed).
     pub fn measure(&self, s: &Scene, probe: &mut Probe) -> Result<Vec<f64>> {
         self.check(s)?;
+        // Checked here and not in `check`: a recorder may be set up before the swimmers come.
+        if s.count() == 0 {
+            if let Some(what) = self.over_the_swimmers() {
+                return Err(super::error::invalid!(
+                    "{} is {what}, and this scene has no swimmers, so it has no value; add swimmers first",
+                    self.name()
+                ));
+            }
+        }
         let v3 = |v: Vector3<f64>| vec![v.x, v.y, v.z];
         Ok(match *self {
             Observable::CenterH(i) => v3(s.center(i)?),
@@ -331,7 +355,14 @@ impl Observable {
         let drift = (v[i] + v[j]) / 2.0;
         let t = s.period()?;
         let d = (s.rigid_diffusion(i)?.translation() + s.rigid_diffusion(j)?.translation()) / 4.0;
-        Ok(drift.norm() * t / (2.0 * d * t).sqrt())
+        let pe = drift.norm() * t / (2.0 * d * t).sqrt();
+        if !pe.is_finite() {
+            return Err(super::error::invalid!(
+                "the Peclet number at {:e} K is beyond what f64 holds: the diffusion coefficient, {d:e} m^2/s, is too small to divide the drift by; give a temperature nearer room temperature (e.g. 300 K)",
+                s.thermal().temperature
+            ));
+        }
+        Ok(pe)
     }
 
     /// Counts of pair distances D_H in `bins` bins on [0, r_max); rows in parallel for large scenes.
@@ -372,7 +403,8 @@ impl Observable {
         s.wall().map_or(0.0, |w| w.z)
     }
 
-    /// The smallest gap between a sphere and the wall (m); +inf without spheres.
+    /// The smallest gap between a sphere and the wall (m); [`Observable::check`] makes sure there
+    /// are both.
     fn wall_gap(s: &Scene) -> f64 {
         let Some(w) = s.wall() else {
             return f64::INFINITY;
@@ -386,7 +418,8 @@ impl Observable {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// The smallest sphere gap of the scene (m); +inf with fewer than two spheres.
+    /// The smallest sphere gap of the scene (m); [`Observable::check`] makes sure there is a
+    /// swimmer, whose two spheres make a pair.
     fn min_gap(s: &Scene) -> f64 {
         s.closest_spheres().map_or(f64::INFINITY, |g| g.0)
     }

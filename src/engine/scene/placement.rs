@@ -297,6 +297,20 @@ impl Scene {
         Ok(())
     }
 
+    /// Whether spheres `x1`, `x2` of swimmer `d` are more than `margin` above the wall, if there
+    /// is one: [`Scene::check_clear_of_wall`] without its message, for the many draws of a random
+    /// placement.
+    pub(in crate::engine) fn clear_of_wall(
+        &self,
+        d: &Dumbbell,
+        x1: &Vector3<f64>,
+        x2: &Vector3<f64>,
+        margin: f64,
+    ) -> bool {
+        self.wall
+            .is_none_or(|w| w.gap(x1, d.a1) > margin && w.gap(x2, d.a2) > margin)
+    }
+
     /// Spheres `x1`, `x2` of swimmer `d` more than `margin` above the wall, if there is one.
     pub(in crate::engine) fn check_clear_of_wall(
         &self,
