@@ -5,85 +5,16 @@
 //! named, and no observable returns inf or NaN as a value. Script cases run in their own `swimlab`
 //! process under a time limit, so a hang fails the test instead of stalling it.
 
-use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use crate::common::cli;
 use swimlab::engine::build::{place_apart, rsa_fill, DRAWS_PER_BODY};
 use swimlab::engine::wall::Wall;
 use swimlab::engine::{Dumbbell, Model, Observable, Scene};
 
-/// Well above any case's real cost (a refusal, or a placement of a few hundred swimmers), far
-/// below the minutes to hours the refused placements once drew for.
-const LIMIT: Duration = Duration::from_secs(60);
-
-/// A fresh folder for one case.
-fn case_dir() -> PathBuf {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static N: AtomicU64 = AtomicU64::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "swimlab-placement-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst)
-    ));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run `swimlab run` on `script` to completion within [`LIMIT`].
-fn run(script: &str) -> Output {
-    let cwd = case_dir();
-    let file = cwd.join("case.rhai");
-    std::fs::write(&file, script).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
-        .args(["run", file.to_str().unwrap()])
-        .current_dir(&cwd)
-        .env("SWIMLAB_PROGRESS", "0")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start swimlab");
-    let start = Instant::now();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            return child.wait_with_output().unwrap();
-        }
-        if start.elapsed() > LIMIT {
-            let _ = child.kill();
-            panic!("did not finish within {LIMIT:?} (a hang):\n{script}");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
-
-/// Run `script`; check the exit code, that the output holds every fragment and none of `absent`,
-/// and that no panic or Rust text surfaced.
+/// [`cli::case_without`], and never an infinity or NaN printed as a value.
 #[track_caller]
 fn case(script: &str, fragments: &[&str], absent: &[&str], code: i32) -> String {
-    let out = run(script);
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(code),
-        "exit code of:\n{script}\n---\n{text}"
-    );
-    for f in fragments {
-        assert!(
-            text.contains(f),
-            "missing {f:?} for:\n{script}\n---\n{text}"
-        );
-    }
-    for bad in absent
-        .iter()
-        .chain(&["internal error", "panicked", "swimlab::", "inf\n", "NaN"])
-    {
-        assert!(!text.contains(bad), "{bad:?} for:\n{script}\n---\n{text}");
-    }
-    text
+    let absent: Vec<&str> = absent.iter().copied().chain(["inf\n", "NaN"]).collect();
+    cli::case_without(script, fragments, &absent, code)
 }
 
 /// The count of a refusal's "so about N fit".

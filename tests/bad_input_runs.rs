@@ -4,18 +4,8 @@
 //! so a hang fails the test instead of stalling it, and a panic shows as the "internal error"
 //! the script boundary turns it into.
 
-use crate::common::cli;
+use crate::common::cli::{self, case_without as case};
 use swimlab::engine::integrators::{Dopri5, OdeSystem, Rosenbrock, Stats, Stepper, Suspension};
-
-/// Run `script` ([`cli::case`]); also check that the output holds none of `absent`.
-#[track_caller]
-fn case(script: &str, fragments: &[&str], absent: &[&str], code: i32) -> String {
-    let text = cli::case(script, fragments, code);
-    for bad in absent {
-        assert!(!text.contains(bad), "{bad:?} for:\n{script}\n---\n{text}");
-    }
-    text
-}
 
 const ONE: &str = "let s = scene();\ns.add(dumbbell());\n";
 

@@ -11,6 +11,7 @@ mod averaged_model;
 mod bad_input;
 mod bad_input_continuum;
 mod bad_input_messages;
+mod bad_input_placement;
 mod bad_input_round_two;
 mod bad_input_runs;
 mod book;

@@ -100,3 +100,13 @@ pub fn check(what: &str, out: &Output, fragments: &[&str], code: i32) -> String 
 pub fn case(script: &str, fragments: &[&str], code: i32) -> String {
     check(script, &run_in(script, &case_dir()), fragments, code)
 }
+
+/// [`case`], and the output holds none of `absent` (a word the old, wrong message used, a NaN).
+#[track_caller]
+pub fn case_without(script: &str, fragments: &[&str], absent: &[&str], code: i32) -> String {
+    let text = case(script, fragments, code);
+    for bad in absent {
+        assert!(!text.contains(bad), "{bad:?} for:\n{script}\n---\n{text}");
+    }
+    text
+}

@@ -7,3 +7,4 @@ mod common;
 mod driver;
 mod newer_api;
 mod script_api;
+mod walls_forces_continuum;
