@@ -4,7 +4,7 @@
 //! so a hang fails the test instead of stalling it, and a panic shows as the "internal error"
 //! the script boundary turns it into.
 
-use crate::common::cli::{self, case_without as case};
+use crate::common::cli::{self, case_without as case, LIMIT};
 use swimlab::engine::integrators::{Dopri5, OdeSystem, Rosenbrock, Stats, Stepper, Suspension};
 
 const ONE: &str = "let s = scene();\ns.add(dumbbell());\n";

@@ -289,3 +289,37 @@ fn the_structure_factor_needs_a_box() {
         "{e}"
     );
 }
+
+/// A smoothing width the grid cannot carry is refused, never a NaN field: far below a cell the
+/// kernel's weights underflow (0/0 per swimmer), far beyond the reach of positions the open-space
+/// grid's cells overflow. Widths the grid resolves are taken, and their fields stay finite.
+#[test]
+fn widths_the_grid_cannot_carry_are_refused() {
+    let boxed = lattice(2, 100e-6);
+    let mut open = Scene::new();
+    open.set_model(Model::Averaged);
+    open.add(Dumbbell::default(), Vector3::zeros(), Vector3::x())
+        .unwrap();
+    open.add(
+        Dumbbell::default(),
+        Vector3::new(30e-6, 0.0, 0.0),
+        Vector3::x(),
+    )
+    .unwrap();
+    let spec = |width| FieldSpec {
+        grid: [8, 8, 8],
+        width: Some(width),
+    };
+    for (s, width, fragment) in [
+        (&boxed, 1e-30, "below 1/32 of the grid's widest cell"),
+        (&open, 1e-30, "below 1/32 of the grid's widest cell"),
+        (&open, 1e300, "beyond the"),
+    ] {
+        let e = Field::of(s, FieldKind::Density, &spec(width)).unwrap_err();
+        assert!(e.to_string().contains(fragment), "{width:e}: {e}");
+    }
+    for (s, width) in [(&boxed, 1e-6), (&open, 1e-6), (&open, 1e-3)] {
+        let f = Field::of(s, FieldKind::Density, &spec(width)).unwrap();
+        assert!(f.values.iter().all(|v| v.is_finite()), "{width:e}");
+    }
+}

@@ -1,7 +1,7 @@
 //! Scene builders: random suspensions and lattices, seeded and reproducible.
 
 use super::cells::CellMap;
-use super::error::{invalid, require_positive, Result};
+use super::error::{invalid, require_positive, short, Result};
 use super::model::Model;
 use super::periodic::separation;
 use super::scene::Scene;
@@ -290,16 +290,6 @@ fn two_balls(r1: f64, r2: f64, dist: f64) -> f64 {
             * (dist * dist + 2.0 * dist * (r1 + r2) - 3.0 * (r1 - r2).powi(2))
             / (12.0 * dist);
         ball(r1) + ball(r2) - lens
-    }
-}
-
-/// `x` to three significant digits, as a reader takes it in: "75", "7.5e-7".
-fn short(x: f64) -> String {
-    let r: f64 = format!("{x:.2e}").parse().unwrap_or(x);
-    if (1e-3..1e6).contains(&r.abs()) {
-        format!("{r}")
-    } else {
-        format!("{r:e}")
     }
 }
 

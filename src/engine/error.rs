@@ -212,3 +212,13 @@ pub fn require_finite(name: &str, value: f64) -> Result<()> {
         Err(invalid!("{name} must be a finite number, got {value}"))
     }
 }
+
+/// `x` to three significant digits, as a reader of a message takes it in: "75", "7.5e-7".
+pub fn short(x: f64) -> String {
+    let r: f64 = format!("{x:.2e}").parse().unwrap_or(x);
+    if (1e-3..1e6).contains(&r.abs()) {
+        format!("{r}")
+    } else {
+        format!("{r:e}")
+    }
+}

@@ -106,6 +106,29 @@ impl FieldSpec {
     }
 }
 
+/// Refuse a smoothing width the grid cannot carry: narrower than 1/32 of the widest cell, the
+/// kernel's weight at the nearest cell centre (half a cell away at most) can fall below e^-128,
+/// and far narrower underflows to nothing (a swimmer would deposit 0/0); wider than the reach of
+/// positions, the open-space grid's cells overflow.
+fn check_width(width: f64, spacing: [f64; 3], scene: &Scene) -> Result<()> {
+    let h = spacing[0].max(spacing[1]).max(spacing[2]);
+    if width < h / 32.0 {
+        return Err(invalid!(
+            "a field's smoothing width of {width:e} m is below 1/32 of the grid's widest cell, {h:e} m: the kernel's weights at the cell centres would underflow; give a width of at least {:e} m, or a finer grid",
+            h / 32.0
+        ));
+    }
+    let reach = scene.reach();
+    if !(width <= reach.limit && h.powi(3).is_finite()) {
+        return Err(invalid!(
+            "a field's smoothing width of {width:e} m is beyond the {:e} m that positions may reach ({}); give a width below that",
+            reach.limit,
+            reach.why
+        ));
+    }
+    Ok(())
+}
+
 /// A field on a regular grid; cell (i, j, k) is centred at origin + (i, j, k)·spacing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Field {
@@ -174,6 +197,7 @@ impl Field {
                 (std::array::from_fn(|d| lo[d] - 4.0 * w + 0.5 * h[d]), h, w)
             }
         };
+        check_width(width, spacing, scene)?;
         let mut f = Field {
             kind,
             grid: n,

@@ -12,7 +12,7 @@ use super::integrators::{Noise, OdeSystem, Problem, Reach};
 use super::mobility::{self_mobility, Mobility};
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use super::spheres::Spheres;
-use super::swimmer::Dumbbell;
+use super::swimmer::{shortest_period, Dumbbell};
 use super::thermal::{lanczos, Thermal};
 use nalgebra::{DMatrix, Vector3};
 
@@ -294,11 +294,7 @@ impl OdeSystem for MicroSystem {
 
     /// The shortest stroke period (0 without swimmers: no scale).
     fn time_scale(&self) -> f64 {
-        let t = self
-            .swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(f64::INFINITY, f64::min);
+        let t = shortest_period(&self.swimmers);
         if t.is_finite() {
             t
         } else {

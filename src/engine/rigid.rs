@@ -17,7 +17,7 @@ use super::integrators::{OdeSystem, Problem, Reach};
 use super::mobility::Mobility;
 use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use super::spheres::Spheres;
-use super::swimmer::Dumbbell;
+use super::swimmer::{shortest_period, Dumbbell};
 use nalgebra::{DMatrix, DVector, Vector3};
 
 /// The rigid-stroke right-hand side with its scratch buffers.
@@ -162,11 +162,7 @@ impl OdeSystem for RigidSystem {
 
     /// The shortest stroke period (0 without swimmers: no scale).
     fn time_scale(&self) -> f64 {
-        let t = self
-            .swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(f64::INFINITY, f64::min);
+        let t = shortest_period(&self.swimmers);
         if t.is_finite() {
             t
         } else {

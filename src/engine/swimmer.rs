@@ -146,3 +146,11 @@ pub fn unit_direction(dir: Vector3<f64>) -> Result<Vector3<f64>> {
     }
     Ok(dir / norm)
 }
+
+/// The shortest stroke period of `swimmers` (s); infinite without swimmers.
+pub fn shortest_period(swimmers: &[Dumbbell]) -> f64 {
+    swimmers
+        .iter()
+        .map(Dumbbell::period)
+        .fold(f64::INFINITY, f64::min)
+}

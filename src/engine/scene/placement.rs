@@ -2,6 +2,7 @@
 //! overlap, no meeting its own image), `add` and `add_many` through cells, and the closest pair.
 
 use super::*;
+use crate::engine::error::short;
 
 /// How far from the origin a swimmer's centre, and how long a box side, may reach, in units of
 /// the scene's smallest sphere radius. A coordinate carries an error of an ulp (2.2e-16 of
@@ -9,16 +10,6 @@ use super::*;
 /// is still resolved to 2.2e-8 of its radius; far beyond, spheres merge (a dumbbell at 1e20 m has
 /// both at one point) and wrapping returns NaN.
 pub const MAX_EXTENT_IN_RADII: f64 = 1e8;
-
-/// `x` to three significant digits, as a reader takes it in: "75", "7.5e-7".
-fn short(x: f64) -> String {
-    let r: f64 = format!("{x:.2e}").parse().unwrap_or(x);
-    if (1e-3..1e6).contains(&r.abs()) {
-        format!("{r}")
-    } else {
-        format!("{r:e}")
-    }
-}
 
 /// The reach [`MAX_EXTENT_IN_RADII`] of swimmers `ds` (m), with the smallest radius; `None` without
 /// swimmers.

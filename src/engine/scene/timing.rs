@@ -213,10 +213,7 @@ impl Scene {
 
     /// The shortest stroke period of the swimmers (s); infinite without swimmers.
     pub fn shortest_period(&self) -> f64 {
-        self.swimmers
-            .iter()
-            .map(Dumbbell::period)
-            .fold(f64::INFINITY, f64::min)
+        crate::engine::swimmer::shortest_period(&self.swimmers)
     }
 
     /// The largest spring relaxation rate k0 (1/γ1 + 1/γ2) in the scene (1/s): the stiffness.
