@@ -104,7 +104,7 @@ fn the_core_is_refused_outside_its_range_and_cheap_within() {
         case(
             &format!("{C}continuum(b, #{{ grid: 4, orientations: 2, core: {core} }});"),
             &[
-                "a continuum's core must lie from 0.25 swimmer lengths, 1.25e-6 m, up to the cutoff 6e-5 m",
+                "a continuum's core must lie from 0.25 swimmer lengths, 1.25e-6 m, up to the cutoff 5.71e-5 m",
                 "leave it out for one length ℓ, 5e-6 m",
             ],
             1,

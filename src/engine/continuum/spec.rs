@@ -4,7 +4,7 @@
 use super::operator::Operator;
 use super::sphere::MAX_DEGREE;
 use super::Population;
-use crate::engine::error::{invalid, Result};
+use crate::engine::error::{invalid, short, Result};
 use crate::engine::fields::gaussian_axis;
 use crate::engine::integrators::{check_tolerance, MIN_DRIFT_TOL};
 use crate::engine::swimmer::Dumbbell;
@@ -152,7 +152,8 @@ impl ContinuumSpec {
         let least = MIN_CORE_IN_LENGTHS * ell;
         if !(core >= least && core < cutoff) {
             return Err(invalid!(
-                "a continuum's core must lie from {MIN_CORE_IN_LENGTHS} swimmer lengths, {least:e} m, up to the cutoff {cutoff:e} m (not included), got {core:e} m: the pair terms are the leading terms of an expansion in ℓ/D for swimmers far apart, and closer than ℓ/4, where their (ℓ/D)⁵ term is 1000 times its size at one length, they describe no pair the particles have; leave it out for one length ℓ, {ell:e} m"
+                "a continuum's core must lie from {MIN_CORE_IN_LENGTHS} swimmer lengths, {least:e} m, up to the cutoff {} m (not included), got {core:e} m: the pair terms are the leading terms of an expansion in ℓ/D for swimmers far apart, and closer than ℓ/4, where their (ℓ/D)⁵ term is 1000 times its size at one length, they describe no pair the particles have; leave it out for one length ℓ, {ell:e} m",
+                short(cutoff)
             ));
         }
         Ok(Lengths { core, width })
