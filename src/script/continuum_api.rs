@@ -5,14 +5,13 @@
 
 use super::convert::{array3, describe, lift, number, script_error, vector3, ScriptResult};
 use super::doc::{doc_entry, Doc};
-use super::scene_api::SceneHandle;
+use super::scene_api::{SceneHandle, SweepCount};
 use crate::engine::continuum::{
     particle_mode, BaseState, Continuum, ContinuumSpec, Mode, WholeOption,
 };
 use crate::engine::fields::{Field, FieldKind};
 use rhai::{Array, Dynamic, Engine, Map, INT};
 use rustfft::num_complex::Complex64;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// A continuum shared by the script values that name it.
@@ -21,26 +20,14 @@ pub struct ContinuumHandle {
     continuum: Arc<Mutex<Continuum>>,
     /// The sweeps whose calls share this continuum now: while any does, it can be read, not
     /// changed.
-    shared_by_sweeps: Arc<AtomicUsize>,
-}
-
-/// While this lives, the continuums it holds are shared by the calls of a sweep (see
-/// [`ContinuumHandle::lock_mut`]).
-pub(super) struct ContinuumSweepShare(Vec<ContinuumHandle>);
-
-impl Drop for ContinuumSweepShare {
-    fn drop(&mut self) {
-        for h in &self.0 {
-            h.shared_by_sweeps.fetch_sub(1, Ordering::SeqCst);
-        }
-    }
+    shared_by_sweeps: SweepCount,
 }
 
 impl ContinuumHandle {
     fn new(c: Continuum) -> Self {
         ContinuumHandle {
             continuum: Arc::new(Mutex::new(c)),
-            shared_by_sweeps: Arc::default(),
+            shared_by_sweeps: SweepCount::default(),
         }
     }
 
@@ -49,12 +36,9 @@ impl ContinuumHandle {
         Arc::ptr_eq(&self.continuum, &other.continuum)
     }
 
-    /// Mark `continuums` as shared by the calls of a sweep for as long as the result lives.
-    pub(super) fn share_in_sweep(continuums: Vec<ContinuumHandle>) -> ContinuumSweepShare {
-        for h in &continuums {
-            h.shared_by_sweeps.fetch_add(1, Ordering::SeqCst);
-        }
-        ContinuumSweepShare(continuums)
+    /// The count of sweeps sharing this continuum.
+    pub(super) fn sweeps(&self) -> &SweepCount {
+        &self.shared_by_sweeps
     }
 
     /// Read the continuum. A lock poisoned by a panic elsewhere still holds a consistent one
@@ -66,11 +50,8 @@ impl ContinuumHandle {
     /// Change the continuum; refused while the calls of a sweep share it: they run at once on
     /// several threads, and changes from them would race (results changing from run to run).
     fn lock_mut(&self) -> ScriptResult<MutexGuard<'_, Continuum>> {
-        if self.shared_by_sweeps.load(Ordering::SeqCst) > 0 {
-            return Err(script_error(
-                "this continuum is shared by every call of the sweep (captured by its closure, or given in more than one parameter), and the calls run at once on several threads: changing it from them would race, and the results would change from run to run; a call may read it, not change it: build the continuum inside the closure, or change a copy there (let d = c.copy(); d.run_periods(1); ...)",
-            ));
-        }
+        self.shared_by_sweeps
+            .refuse_change("continuum", "let d = c.copy(); d.run_periods(1); ...")?;
         Ok(self.lock())
     }
 }

@@ -22,17 +22,44 @@ pub const MAX_SCENE_FILE_BYTES: u64 = 256 << 20;
 pub struct SceneHandle {
     sim: Arc<RwLock<Simulation>>,
     /// The sweeps whose calls share this scene now: while any does, it can be read, not changed.
-    shared_by_sweeps: Arc<AtomicUsize>,
+    shared_by_sweeps: SweepCount,
 }
 
-/// While this lives, the scenes it holds are shared by the calls of a sweep (see
-/// [`SceneHandle::borrow_mut`]).
-pub(super) struct SweepShare(Vec<SceneHandle>);
+/// How many sweeps' calls share a script value now (a scene, a continuum): they run at once on
+/// several threads, so while any does, the value may be read through its handle, not changed.
+#[derive(Debug, Clone, Default)]
+pub(super) struct SweepCount(Arc<AtomicUsize>);
+
+impl SweepCount {
+    /// Refuse a change of this `what` ("scene", "continuum") while a sweep shares it; `copy` is
+    /// the fix, a change of a copy ("let t = s.copy(); t.run_periods(1); ...").
+    pub(super) fn refuse_change(&self, what: &str, copy: &str) -> ScriptResult<()> {
+        if self.0.load(Ordering::SeqCst) > 0 {
+            return Err(script_error(format!(
+                "this {what} is shared by every call of the sweep (captured by its closure, or given in more than one parameter), and the calls run at once on several threads: changing it from them would race, and the results would change from run to run; a call may read it, not change it: build the {what} inside the closure, or change a copy there ({copy})"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// While this lives, the values whose counts it holds are shared by the calls of a sweep.
+pub(super) struct SweepShare(Vec<SweepCount>);
+
+impl SweepShare {
+    /// Share the values of `counts` (each once) until the result is dropped.
+    pub(super) fn new(counts: Vec<SweepCount>) -> Self {
+        for c in &counts {
+            c.0.fetch_add(1, Ordering::SeqCst);
+        }
+        SweepShare(counts)
+    }
+}
 
 impl Drop for SweepShare {
     fn drop(&mut self) {
-        for h in &self.0 {
-            h.shared_by_sweeps.fetch_sub(1, Ordering::SeqCst);
+        for c in &self.0 {
+            c.0.fetch_sub(1, Ordering::SeqCst);
         }
     }
 }
@@ -53,7 +80,7 @@ impl SceneHandle {
         })));
         SceneHandle {
             sim: Arc::new(RwLock::new(sim)),
-            shared_by_sweeps: Arc::default(),
+            shared_by_sweeps: SweepCount::default(),
         }
     }
 
@@ -62,12 +89,9 @@ impl SceneHandle {
         Arc::ptr_eq(&self.sim, &other.sim)
     }
 
-    /// Mark `scenes` as shared by the calls of a sweep for as long as the result lives.
-    pub(super) fn share_in_sweep(scenes: Vec<SceneHandle>) -> SweepShare {
-        for h in &scenes {
-            h.shared_by_sweeps.fetch_add(1, Ordering::SeqCst);
-        }
-        SweepShare(scenes)
+    /// The count of sweeps sharing this scene.
+    pub(super) fn sweeps(&self) -> &SweepCount {
+        &self.shared_by_sweeps
     }
 
     /// Read the simulation (and through it the scene). A lock poisoned by a panic elsewhere still
@@ -79,11 +103,8 @@ impl SceneHandle {
     /// Change the simulation; refused while the calls of a sweep share the scene: they run at once
     /// on several threads, and changes from them would race (results changing from run to run).
     pub fn borrow_mut(&self) -> ScriptResult<RwLockWriteGuard<'_, Simulation>> {
-        if self.shared_by_sweeps.load(Ordering::SeqCst) > 0 {
-            return Err(script_error(
-                "this scene is shared by every call of the sweep (captured by its closure, or given in more than one parameter), and the calls run at once on several threads: changing it from them would race, and the results would change from run to run; a call may read it, not change it: build the scene inside the closure, or change a copy there (let t = s.copy(); t.run_periods(1); ...)",
-            ));
-        }
+        self.shared_by_sweeps
+            .refuse_change("scene", "let t = s.copy(); t.run_periods(1); ...")?;
         Ok(self.write())
     }
 

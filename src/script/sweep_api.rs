@@ -13,7 +13,7 @@ use super::continuum_api::ContinuumHandle;
 use super::convert::{script_error, ScriptResult};
 use super::doc::{doc_entry, Doc};
 use super::observable_api::RecorderHandle;
-use super::scene_api::SceneHandle;
+use super::scene_api::{SceneHandle, SweepShare};
 use rayon::prelude::*;
 use rhai::{Array, Dynamic, Engine, EvalAltResult, FnPtr, Map, NativeCallContext, INT};
 
@@ -71,8 +71,13 @@ fn sweep(
             continuums.push(h);
         }
     }
-    let _scenes = SceneHandle::share_in_sweep(scenes);
-    let _continuums = ContinuumHandle::share_in_sweep(continuums);
+    let _shared = SweepShare::new(
+        scenes
+            .iter()
+            .map(|h| h.sweeps().clone())
+            .chain(continuums.iter().map(|h| h.sweeps().clone()))
+            .collect(),
+    );
     // Captured scenes and continuums reach the calls as their handles, not as the captured
     // variables: Rhai holds a captured variable's lock through a whole method call on it, so calls
     // running at once would find it taken (its bare "Data race detected", after a few
