@@ -1,15 +1,12 @@
 //! The one place a Rhai engine is built and scripts are run.
 
+use super::source::{read_text, strip_bom, MAX_SOURCE_BYTES};
 use super::{
     continuum_api, csv_api, dumbbell_api, field_api, float_cmp, integrator_api, interrupt, limits,
     observable_api, panic_guard::guard, params, picture_api, plot_api, render_error, scene_api,
-    scene_settings_api, stdlib, sweep_api, types, util_api, wall_api, wrong_calls,
+    scene_settings_api, signatures, stdlib, sweep_api, types, util_api, wall_api, wrong_calls,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
-
-/// The largest script or scene file swimlab reads (bytes): far above any real one, and a bound
-/// on what a wrong path (a device, a huge data file) can cost.
-pub const MAX_SOURCE_BYTES: u64 = 16 << 20;
 
 /// A Rhai engine with the whole swimlab vocabulary registered.
 pub fn engine() -> Engine {
@@ -20,6 +17,7 @@ pub fn engine() -> Engine {
 /// imports itself (the REPL keeps imports across inputs) without compiling them again.
 pub fn engine_and_stdlib() -> (Engine, rhai::module_resolvers::StaticModuleResolver) {
     let (mut engine, embedded) = vocabulary_engine();
+    signatures::install(&engine);
     wrong_calls::register(&mut engine);
     (engine, embedded)
 }
@@ -55,11 +53,6 @@ pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModu
     // Ctrl-C also stops plain script loops between statements.
     engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
     (engine, embedded)
-}
-
-/// Script text without a leading UTF-8 byte-order mark (editors on Windows write one).
-pub fn strip_bom(source: &str) -> &str {
-    source.strip_prefix('\u{feff}').unwrap_or(source)
 }
 
 /// Run script text; on error return the rendered message (file, line, column, caret).
@@ -115,41 +108,6 @@ pub fn run_source_with(
     })
 }
 
-/// Read a text file of at most `max` bytes, with errors that name the file and the fix.
-pub fn read_text(path: &std::path::Path, max: u64, what: &str) -> Result<String, String> {
-    use std::io::Read;
-    let shown = path.display();
-    let too_big = || {
-        format!(
-            "cannot read {what} {shown}: it is larger than {max} bytes, more than any {what} swimlab writes; check the path"
-        )
-    };
-    let file = std::fs::File::open(path).map_err(|e| {
-        format!("cannot read {what} {shown}: {e}; check the path (relative paths start in the working folder)")
-    })?;
-    if let Ok(m) = file.metadata() {
-        if m.is_dir() {
-            return Err(format!(
-                "cannot read {what} {shown}: it is a folder; give a file"
-            ));
-        }
-        // A regular file is measured before reading; a device or pipe by reading at most max + 1.
-        if m.is_file() && m.len() > max {
-            return Err(too_big());
-        }
-    }
-    let mut bytes = Vec::new();
-    file.take(max + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
-    if bytes.len() as u64 > max {
-        return Err(too_big());
-    }
-    String::from_utf8(bytes).map_err(|e| {
-        format!("cannot read {what} {shown}: it is not UTF-8 text ({e}); save it as UTF-8")
-    })
-}
-
 /// Run a script file.
 pub fn run_file(path: &std::path::Path, scope: &mut Scope) -> Result<(), String> {
     let source =
@@ -175,4 +133,22 @@ pub fn eval_expression(expr: &str) -> Result<Option<String>, String> {
             .map_err(|e| render_error("-e", expr, &e))?;
         Ok((!v.is_unit()).then(|| super::show(&v)))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    /// The answering forms are added beside the registered ones, never in place of one: a
+    /// registered form of the same parameter types (all `any`) would share its hash, and the
+    /// later registration would replace it.
+    #[test]
+    fn the_answering_forms_replace_no_registered_form() {
+        let (vocabulary, _) = super::vocabulary_engine();
+        let full = super::engine();
+        let added: usize = super::wrong_calls::arities().values().map(Vec::len).sum();
+        assert!(added > 0);
+        assert_eq!(
+            full.gen_fn_signatures(false).len(),
+            vocabulary.gen_fn_signatures(false).len() + added
+        );
+    }
 }

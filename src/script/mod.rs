@@ -26,6 +26,7 @@ mod scene_api;
 mod scene_settings_api;
 mod show;
 mod signatures;
+mod source;
 pub mod stdlib;
 mod sweep_api;
 mod types;
@@ -44,8 +45,8 @@ pub use crate::engine::files::write_atomically;
 pub use crate::engine::gpu::quiet_device_selection;
 pub use dumbbell_api::DumbbellSpec;
 pub use engine_builder::{
-    engine, engine_and_stdlib, eval_expression, read_text, run_file, run_file_with, run_source,
-    run_source_with, strip_bom, MAX_SOURCE_BYTES,
+    engine, engine_and_stdlib, eval_expression, run_file, run_file_with, run_source,
+    run_source_with,
 };
 pub use observable_api::RecorderHandle;
 pub use panic_guard::guard;
@@ -53,5 +54,6 @@ pub use picture_api::Picture;
 pub use render::render_error;
 pub use scene_api::SceneHandle;
 pub use show::show;
+pub use source::{read_text, strip_bom, MAX_SOURCE_BYTES};
 pub use types::type_word;
 pub use util_api::quick;

@@ -42,12 +42,22 @@ fn script_type(t: &str) -> String {
     }
 }
 
+/// The vocabulary, read once per process by [`install`].
+static VOCABULARY: OnceLock<Vocabulary> = OnceLock::new();
+
 /// The vocabulary of [`super::engine()`] (what it registers besides the forms of
-/// `wrong_calls`, which are built from this).
+/// `wrong_calls`, which are built from this), installed by the engine builder before any
+/// script runs.
 pub fn vocabulary() -> &'static Vocabulary {
-    static V: OnceLock<Vocabulary> = OnceLock::new();
-    V.get_or_init(|| {
-        let (engine, _) = super::engine_builder::vocabulary_engine();
+    VOCABULARY
+        .get()
+        .expect("the engine builder installs the vocabulary before any script runs")
+}
+
+/// Reads the vocabulary from `engine`'s metadata, once per process: the engine builder hands in
+/// each engine it builds, with every registration but the forms of `wrong_calls`.
+pub fn install(engine: &rhai::Engine) {
+    VOCABULARY.get_or_init(|| {
         let mut v = Vocabulary::default();
         let json = engine.gen_fn_metadata_to_json(false).unwrap_or_default();
         let parsed: serde_json::Value = serde_json::from_str(&json).unwrap_or_default();
@@ -94,7 +104,7 @@ pub fn vocabulary() -> &'static Vocabulary {
             }
         }
         v
-    })
+    });
 }
 
 /// A Rhai type name in a "Function not found" signature as a script user knows it.

@@ -19,7 +19,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::sync::OnceLock;
 
 /// Per swimlab function name, the arities that get the all-`Dynamic` form.
-fn arities() -> &'static BTreeMap<String, Vec<usize>> {
+pub(super) fn arities() -> &'static BTreeMap<String, Vec<usize>> {
     static A: OnceLock<BTreeMap<String, Vec<usize>>> = OnceLock::new();
     A.get_or_init(|| {
         let rhai_names: BTreeSet<String> = Engine::new()
@@ -102,22 +102,4 @@ fn message(engine: &Engine, name: &str, args: &[&mut Dynamic]) -> String {
         "{name} ({})",
         types.join(", ")
     )))
-}
-
-#[cfg(test)]
-mod tests {
-    /// The answering forms are added beside the registered ones, never in place of one: a
-    /// registered form of the same parameter types (all `any`) would share its hash, and the
-    /// later registration would replace it.
-    #[test]
-    fn the_answering_forms_replace_no_registered_form() {
-        let (vocabulary, _) = super::super::engine_builder::vocabulary_engine();
-        let full = super::super::engine();
-        let added: usize = super::arities().values().map(Vec::len).sum();
-        assert!(added > 0);
-        assert_eq!(
-            full.gen_fn_signatures(false).len(),
-            vocabulary.gen_fn_signatures(false).len() + added
-        );
-    }
 }

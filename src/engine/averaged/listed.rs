@@ -2,8 +2,9 @@
 //! centres move (rebuilt once a centre has moved half the skin), their slot arrays refilled at
 //! every right-hand side, and the steric forces and the contact guard through their near rows.
 
+use super::list_rows::{self, SlotConst};
 use super::{
-    list_rows, pair_weight, AveragedSystem, Problem, Soa, DEFAULT_SKIN_OF_CUTOFF, LIST_SWIMMERS,
+    pair_weight, AveragedSystem, Problem, Soa, DEFAULT_SKIN_OF_CUTOFF, LIST_SWIMMERS,
     PARALLEL_SWIMMERS, STATE_PER_SWIMMER,
 };
 use crate::engine::contacts::Steric;
@@ -14,19 +15,6 @@ use rayon::prelude::*;
 /// Above this share of swimmers leaving their lists at once, the whole list is built anew
 /// instead of relisting them one by one.
 pub const MAX_RELISTED_FRACTION: f64 = 0.1;
-
-/// A swimmer's constants, kept by slot so that a pass in slot order reads them in order.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct SlotConst {
-    /// The far rows' prefactors ([`super::lanes::prefactors`]).
-    pub(super) pre: [f64; 4],
-    /// Its length ℓ (m).
-    ell: f64,
-    /// Its spheres' weights (w1, w2): the spheres sit at −w2ℓN and +w1ℓN from its centre.
-    w: (f64, f64),
-    /// Its sphere radii (m).
-    a: [f64; 2],
-}
 
 /// The list and the arrays in its slot order.
 #[derive(Debug, Clone, Default)]
