@@ -1,5 +1,5 @@
 //! One dumbbell swimmer: two spheres joined by a spring whose rest length oscillates,
-//! L(t) = ℓ + λ sin(ωt + φ) (PHYSICS.md, "The microscopic model").
+//! L(t) = ℓ + λ sin(ωt + φ): the stroke of the microscopic model.
 
 use super::error::{invalid, require_finite, require_positive, Result};
 use nalgebra::Vector3;
