@@ -1,9 +1,9 @@
 //! The largest stable step of each explicit method, found by bisection, as a function of the spring
 //! constant and the radii, against the linear estimate: the spring mode relaxes at
 //! rate = k0 (1/γ1 + 1/γ2), and the stability regions of forward Euler and classic RK4 end at −2
-//! and −2.785 on the real axis, so forward Euler is stable for dt·rate < 2, classic
-//! RK4 for dt·rate < 2.785. Also what each method does beyond its limit. The measured limits are higher:
-//! the dumbbell's own hydrodynamic interaction slows its spring mode ([`hi_factor`]).
+//! and −2.785 on the real axis, so forward Euler is stable for dt·rate < 2, classic RK4 for
+//! dt·rate < 2.785. Also what each method does beyond its limit. The measured limits are
+//! higher: the dumbbell's own hydrodynamic interaction slows its spring mode ([`hi_factor`]).
 
 use super::table::Table;
 use crate::engine::{Dumbbell, IntegratorSpec, Scene, Simulation};

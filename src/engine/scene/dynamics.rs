@@ -233,11 +233,11 @@ impl Scene {
 pub const RK4_DEFAULT_DRIFT_ERROR: f64 = 1.1e-6;
 
 /// The largest inner RK4 step of stroboscopic averaging, in units of 1/rate (rate = the stiffest
-/// spring's k0(1/γ1 + 1/γ2)): RK4's stability region ends at −2.785 on the real axis,
-/// so a spring mode relaxing at that rate is stable for dt·rate < 2.785 (the hydrodynamic
-/// interaction slows the spring mode, so the true limit lies higher, as `bench stability`
-/// shows: the book's design notes), and 2.5 keeps a tenth in hand. At tol 1e-3 the
-/// accuracy-bound step, 2.47/rate, is below it.
+/// spring's k0(1/γ1 + 1/γ2)): RK4's stability region ends at −2.785 on the real axis, so a
+/// spring mode relaxing at that rate is stable for dt·rate < 2.785 (the hydrodynamic interaction
+/// slows the spring mode, so the true limit lies higher, as `bench stability` shows: the book's
+/// design notes), and 2.5 keeps a tenth in hand. At tol 1e-3 the accuracy-bound step,
+/// 2.47/rate, is below it.
 pub const RK4_STABLE_STEP_RATE: f64 = 2.5;
 
 /// RK4 steps per period above which the springs count as stiff: `auto` and stroboscopic
