@@ -1,5 +1,6 @@
-//! Issue 38, "nothing lost, nothing hangs, round two": the newer surfaces (boxes, noise, fields,
-//! stroboscopic and `auto`, trajectories, pictures, sweeps) tried as a hostile new user would.
+//! Boxes, noise, fields, stroboscopic averaging and `auto`, trajectories, pictures and sweeps
+//! tried as a hostile new user would: wrong types named in words, limits, one writer per file,
+//! paths that cannot be written, placements that cannot be carried; nothing lost, nothing hangs.
 //! Each case runs in its own `swimlab` process under a time limit, so a hang or an abort fails
 //! the test instead of stalling it, and a panic shows as the "internal error" the script boundary
 //! turns it into.

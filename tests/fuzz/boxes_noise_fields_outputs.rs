@@ -1,13 +1,14 @@
-//! A seeded fuzz of the newer script API (issue 38): boxes and Ewald sums, thermal noise, fields
-//! and the structure factor, stroboscopic averaging and `auto`, trajectories, pictures and
-//! animations, sweeps (shared scenes included), notes and the one-writer-per-file rule. A few
-//! hundred short scripts of random calls with random, often hostile, arguments, each starting
-//! from one of several scenes (open space, a box, the averaged model, noise). Every script must
-//! end by itself or stop promptly when interrupted (as Ctrl-C would); no panic may reach the
-//! script boundary, where it would show as an "internal error"; no message may show a Rust path
-//! or a Rust debug form. An abort (out of memory) ends this test process, which fails the test.
+//! A seeded fuzz of boxes and Ewald sums, thermal noise, fields and the structure factor,
+//! stroboscopic averaging and `auto`, trajectories, pictures and animations, sweeps (shared scenes
+//! included), notes and the one-writer-per-file rule. A few hundred short scripts of random calls
+//! with random, often hostile, arguments, each starting from one of several scenes (open space, a
+//! box, the averaged model, noise). Every script must end by itself or stop promptly when
+//! interrupted (as Ctrl-C would); no panic may reach the script boundary, where it would show as an
+//! "internal error"; no message may show a Rust path or a Rust debug form. An abort (out of memory)
+//! ends this test process, which fails the test.
 //!
-//! The older API has its own fuzz (`script_api.rs`); the driver is shared (`driver.rs`).
+//! Scenes, swimmers, recorders and files have their own fuzz (`script_api.rs`); the driver is
+//! shared (`driver.rs`).
 
 use super::driver::{self, Fuzz};
 use crate::common::Rng;
@@ -285,13 +286,16 @@ fn script(rng: &mut Rng, paths: &[String]) -> String {
 }
 
 #[test]
-fn newer_api_scripts_neither_panic_nor_hang_nor_leak_rust_names() {
-    let dir = std::env::temp_dir().join(format!("swimlab-fuzz-newer-{}", std::process::id()));
+fn box_noise_field_and_output_scripts_neither_panic_nor_hang_nor_leak_rust_names() {
+    let dir = std::env::temp_dir().join(format!(
+        "swimlab-fuzz-boxes-noise-fields-outputs-{}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let paths = paths(&dir.display().to_string());
     let report = Fuzz {
-        name: "newer API",
+        name: "boxes, noise, fields, outputs",
         seed: SEED,
         scripts: SCRIPTS,
         captured: true,
