@@ -297,11 +297,9 @@ fn reach<'a>(graph: &'a Graph, start: &'a String, forward: bool) -> BTreeSet<&'a
     let mut queue = vec![start];
     while let Some(n) = queue.pop() {
         for (m, arrows) in graph {
-            let next: Vec<&String> = if forward {
-                (m == n)
-                    .then(|| arrows.keys().collect())
-                    .unwrap_or_default()
-            } else if arrows.contains_key(n) {
+            let next: Vec<&String> = if forward && m == n {
+                arrows.keys().collect()
+            } else if !forward && arrows.contains_key(n) {
                 vec![m]
             } else {
                 vec![]
