@@ -3,13 +3,16 @@
 //! the paths its code writes are resolved, through re-exports, to the files that hold what they
 //! name ([`crate_map`]). From that:
 //! - no folder has an import circle between its files or subfolders (each module readable with
-//!   only those below it); a circle is shown as its chain, with the line of each arrow;
+//!   only those below it; the folder's own mod.rs is the folder, not one of them); a circle is
+//!   shown as its chain, with the line of each arrow;
 //! - the layers import along the arrows the README draws: each layer's row lists exactly the
 //!   layers (and, in parentheses, their modules) and the dependencies it uses;
 //! - every file of src/ has a row (`x/` is the folder's mod.rs; `{a,b}` patterns name several)
 //!   and every row a file;
-//! - an engine module's row lists exactly the engine modules it (with its child modules)
-//!   imports; `error` is open to all.
+//! - every other row lists exactly what its files (with their child modules) import, each
+//!   import named where its path leaves the row's module: an engine module's row names the
+//!   engine modules it uses, a file's row in `engine/gpu/` its siblings and those engine
+//!   modules; in the engine, `error` is open to all.
 
 mod crate_map;
 mod rust_source;
