@@ -7,6 +7,7 @@
 //!   because the dumbbell is force-free, so they are never added (no cancellation in floating point);
 //! - db/dt = −f (1/γ₁ + 1/γ₂) + u₂ − u₁, γ = 6πμa.
 
+use super::boundary::Boundary;
 use super::contacts::Contacts;
 use super::integrators::{Noise, OdeSystem, Problem, Reach};
 use super::mobility::{self_mobility, Mobility};
@@ -70,11 +71,15 @@ impl MicroSystem {
         }
     }
 
-    /// Take `operator` as the boundary's mobility (open space until set). The stiff own-pair
-    /// rates behind rosw's Jacobian stay open space's: a W-method needs only an approximate
-    /// Jacobian, and a box longer than the swimmer changes the own pair little.
-    pub fn set_mobility(&mut self, operator: Box<dyn crate::engine::mobility::MobilityOperator>) {
-        self.spheres.set_mobility(operator);
+    /// Put the spheres in `boundary`, whose mobility is `operator` (open space until set). The
+    /// stiff own-pair rates behind rosw's Jacobian stay open space's: a W-method needs only an
+    /// approximate Jacobian, and a box longer than the swimmer changes the own pair little.
+    pub fn set_boundary(
+        &mut self,
+        boundary: Boundary,
+        operator: Box<dyn crate::engine::mobility::MobilityOperator>,
+    ) {
+        self.spheres.set_boundary(boundary, operator);
     }
 
     /// The constant external force on every sphere (N; none when empty).

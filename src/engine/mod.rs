@@ -8,6 +8,7 @@
 pub mod advance;
 pub mod averaged;
 pub mod backend;
+pub mod boundary;
 pub mod build;
 pub mod calibrate;
 pub mod cells;

@@ -12,6 +12,7 @@
 //! and dN/dt = (I − NNᵀ)(u₂ − u₁)/L, u the interaction velocities. Nothing is stiff any more: the
 //! step is set by the stroke, not by the spring.
 
+use super::boundary::Boundary;
 use super::contacts::Contacts;
 use super::integrators::{OdeSystem, Problem, Reach};
 use super::mobility::Mobility;
@@ -87,9 +88,13 @@ impl RigidSystem {
         self.spheres.set_external(external);
     }
 
-    /// Take `operator` as the boundary's mobility (open space until set).
-    pub fn set_mobility(&mut self, operator: Box<dyn crate::engine::mobility::MobilityOperator>) {
-        self.spheres.set_mobility(operator);
+    /// Put the spheres in `boundary`, whose mobility is `operator` (open space until set).
+    pub fn set_boundary(
+        &mut self,
+        boundary: Boundary,
+        operator: Box<dyn crate::engine::mobility::MobilityOperator>,
+    ) {
+        self.spheres.set_boundary(boundary, operator);
     }
 
     /// The constraint tensions at time `t` (N), in swimmer order.

@@ -24,7 +24,7 @@
 
 use super::choice::{self, Choice, Named};
 use super::error::{invalid, unsupported, Result, Setting};
-use super::mobility::{self_mobility, Mobility, MobilityOperator};
+use super::mobility::{block_matrix, self_mobility, Blocks, Mobility, MobilityOperator};
 use super::periodic::{PeriodicBox, WavePhases};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
@@ -518,20 +518,10 @@ impl Ewald {
 
     /// The full 3N×3N periodic mobility matrix, Stokes drag included (tests, dense noise roots).
     pub fn matrix(&self, pos: &[Vector3<f64>], radii: &[f64]) -> DMatrix<f64> {
-        let n = pos.len();
-        let mut m = DMatrix::zeros(3 * n, 3 * n);
-        for a in 0..n {
-            for b in a..n {
-                let r0 = self.periodic.min_image(pos[a] - pos[b]);
-                let h = self.block(&r0, radii[a], radii[b], a == b);
-                m.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&h);
-                if a != b {
-                    m.fixed_view_mut::<3, 3>(3 * b, 3 * a)
-                        .copy_from(&h.transpose());
-                }
-            }
-        }
-        m
+        block_matrix(pos.len(), Blocks::Upper, |a, b| {
+            let r0 = self.periodic.min_image(pos[a] - pos[b]);
+            self.block(&r0, radii[a], radii[b], a == b)
+        })
     }
 }
 
@@ -578,10 +568,6 @@ impl MobilityOperator for Ewald {
 
     fn matrix(&self, pos: &[Vector3<f64>], radii: &[f64]) -> DMatrix<f64> {
         Ewald::matrix(self, pos, radii)
-    }
-
-    fn periodic(&self) -> Option<&PeriodicBox> {
-        Some(&self.periodic)
     }
 
     fn boxed(&self) -> Box<dyn MobilityOperator> {

@@ -67,9 +67,7 @@ impl Scene {
     /// probe it). A wall beyond the reach of the swimmers now in the scene (set before them, or
     /// before a smaller one came) is refused here, where every run and rate starts.
     pub fn system(&self) -> Result<Box<dyn OdeSystem>> {
-        if let Some(w) = &self.wall {
-            self.check_wall_reach(w)?;
-        }
+        self.check_boundary_reach()?;
         Ok(match self.model {
             Model::Micro => {
                 let mut sys = MicroSystem::new(
@@ -80,7 +78,7 @@ impl Scene {
                     self.contacts,
                 );
                 sys.set_thermal(self.thermal);
-                sys.set_mobility(self.mobility_operator()?);
+                sys.set_boundary(self.boundary, self.mobility_operator()?);
                 sys.set_external(self.sphere_forces());
                 sys.set_reach(self.reach());
                 Box::new(sys)
@@ -100,7 +98,7 @@ impl Scene {
                 let mut sys =
                     AveragedSystem::new(&self.swimmers, &self.base, self.coefficients, &self.state);
                 sys.set_cutoff(self.averaged_cutoff()?);
-                sys.set_periodic(self.periodic);
+                sys.set_periodic(self.periodic().copied());
                 sys.set_contacts(self.contacts, self.mu);
                 sys.set_thermal(self.thermal, &self.swimmers, self.mu, self.mobility)?;
                 Box::new(sys)
@@ -119,7 +117,10 @@ impl Scene {
             self.contacts.allow_overlap,
         );
         // The constraint solve takes blocks, which are Beenakker's sums.
-        sys.set_mobility(self.mobility_operator_by(EwaldMethod::Beenakker)?);
+        sys.set_boundary(
+            self.boundary,
+            self.mobility_operator_by(EwaldMethod::Beenakker)?,
+        );
         sys.set_external(self.sphere_forces());
         sys.set_reach(self.reach());
         Ok(sys)
@@ -133,7 +134,7 @@ impl Scene {
     /// skin (every right-hand side rebuilds them).
     pub fn cost_notices(&self) -> Vec<(&'static str, EngineError)> {
         let mut out = Vec::new();
-        if let (Model::Averaged, Some(b), Some(c)) = (self.model, &self.periodic, self.cutoff) {
+        if let (Model::Averaged, Some(b), Some(c)) = (self.model, self.periodic(), self.cutoff) {
             let half = 0.5 * b.shortest();
             if self.count() >= crate::engine::averaged::LIST_SWIMMERS && c >= half {
                 out.push((
@@ -180,7 +181,7 @@ impl Scene {
     /// the cost, for pair terms that change the rates by far less than a suspension's tolerance
     /// (the measurements are in the book's "Suspensions, boxes and fields").
     pub fn averaged_cutoff(&self) -> Result<Option<f64>> {
-        let Some(b) = &self.periodic else {
+        let Some(b) = self.periodic() else {
             return Ok(self.cutoff);
         };
         let half = 0.5 * b.shortest();
@@ -194,9 +195,9 @@ impl Scene {
     }
 
     /// The averaged equations are those of swimmers in open space or a box, free of external
-    /// forces: a wall or external forces are refused with the reason.
+    /// forces: a solid boundary (a wall) or external forces are refused with the reason.
     pub(crate) fn check_averaged_open(&self) -> Result<()> {
-        if self.wall.is_some() {
+        if self.geometry().solid() {
             return Err(unsupported(
                 "the averaged model has no wall equations (its pair terms are open space's); long runs near a wall come from auto or stroboscopic averaging on the microscopic model",
                 &[Setting::Model("micro"), Setting::Model("rigid"), Setting::NoWall],

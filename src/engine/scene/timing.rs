@@ -92,7 +92,7 @@ impl Scene {
     /// `suspension(tol)`, whose error is each swimmer's own, where a pair's is the drift's.
     pub fn is_suspension(&self) -> bool {
         self.model == Model::Averaged
-            && (self.periodic.is_some()
+            && (self.periodic().is_some()
                 || self.cutoff.is_some()
                 || self.contacts.steric.is_some()
                 || self.count() >= SUSPENSION_SWIMMERS)
