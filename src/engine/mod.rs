@@ -27,6 +27,7 @@ pub mod integrators;
 pub mod micro;
 pub mod mobility;
 pub mod model;
+pub mod models;
 pub mod neighbours;
 pub mod observable;
 pub mod open_space;

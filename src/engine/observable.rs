@@ -344,7 +344,7 @@ impl Observable {
         let mut quiet = s.clone();
         quiet.set_temperature(0.0)?;
         quiet.set_integrator(None);
-        if quiet.model() != super::model::Model::Averaged {
+        if !quiet.swimmer_model().stroke_averaged() {
             // A noisy state lies off the stroke's cycle by the thermal spring fluctuation, whose
             // relaxation moves R_H (the dumbbell's own spheres interact) by far more than a
             // period's drift: relax for one period first.

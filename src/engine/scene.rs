@@ -10,7 +10,6 @@
 //! and what the next run costs), `external` (external forces, and what a failed step learns
 //! from them) and `save` (JSON, and validation on load).
 
-use super::averaged::AveragedSystem;
 use super::backend::Backend;
 use super::boundary::{Boundary, Extent, Geometry, Kind, MobilitySettings};
 use super::contacts::{Contacts, Overlaps, Steric};
@@ -20,11 +19,12 @@ use super::error::{
 use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_FROM_SPHERES};
 use super::forces::{ExternalForces, Gravity};
 use super::integrators::{IntegratorSpec, OdeSystem, Reach, Stats};
-use super::micro::MicroSystem;
 use super::mobility::{Mobility, MobilityOperator};
-use super::model::{set_vec3, vec3, Coefficients, Model, STATE_PER_SWIMMER};
+use super::model::{
+    set_vec3, vec3, Coefficients, Model, SceneView, SwimmerModel, STATE_PER_SWIMMER,
+};
+use super::models;
 use super::periodic::PeriodicBox;
-use super::rigid::RigidSystem;
 use super::swimmer::{unit_direction, Dumbbell};
 use super::thermal::{NoiseRoot, Thermal};
 use super::wall::Wall;

@@ -166,7 +166,7 @@ fn picture<'a>(scene: &Scene, opts: &'a SnapshotOptions) -> Result<ScenePicture<
         (p[depth] + q[depth]) / 2.0
     };
     order.sort_by(|&i, &j| depth_of(i).total_cmp(&depth_of(j)));
-    let mut discs = Vec::with_capacity(2 * scene.count());
+    let mut discs = Vec::with_capacity(scene.sphere_count());
     let mut rods = Vec::with_capacity(scene.count());
     for i in order {
         let (p1, p2) = scene.shown_spheres(i);

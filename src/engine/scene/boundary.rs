@@ -69,12 +69,11 @@ impl Scene {
         let old = std::mem::replace(&mut self.boundary, new);
         if g.periodic().is_some() {
             if let Some((gap, a, c)) = self.closest_spheres() {
-                if gap <= 0.0 && !(self.contacts.allow_overlap && a / 2 != c / 2) {
+                let (sa, sc) = (self.owner(a), self.owner(c));
+                if gap <= 0.0 && !(self.contacts.allow_overlap && sa != sc) {
                     self.boundary = old;
                     return Err(invalid!(
-                        "in that box sphere {a} (swimmer {}) would overlap the image of sphere {c} (swimmer {}) by {:.3e} m; use a larger box or move the swimmers",
-                        a / 2,
-                        c / 2,
+                        "in that box sphere {a} (swimmer {sa}) would overlap the image of sphere {c} (swimmer {sc}) by {:.3e} m; use a larger box or move the swimmers",
                         -gap
                     ));
                 }
@@ -127,7 +126,7 @@ impl Scene {
         MobilitySettings {
             mu: self.mu,
             kind: self.mobility,
-            spheres: 2 * self.count(),
+            spheres: self.sphere_count(),
             ewald_tol: self.ewald_tol,
             ewald_method: method,
         }

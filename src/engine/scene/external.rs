@@ -22,12 +22,6 @@ impl Scene {
         Ok(())
     }
 
-    /// The external force on every sphere in sphere order (empty when there is none).
-    pub(crate) fn sphere_forces(&self) -> Vec<Vector3<f64>> {
-        self.external
-            .per_sphere(self.swimmers.iter().flat_map(|d| [d.a1, d.a2]))
-    }
-
     /// A failed step's problem with what the scene's settings tell about it: external forces that
     /// drive a sphere across the whole reach of positions within one stroke period are far beyond
     /// what the swimmers can carry, and whatever the guards saw (a stalled step, a state gone NaN,
@@ -71,7 +65,7 @@ impl Scene {
         };
         Some(format!(
             "the external forces drive sphere {k} (swimmer {}) at {speed}, its Stokes speed under {force:.3e} N, across the {reach:e} m that positions may reach in less than a stroke period ({period:.3e} s): far beyond what the swimmers can carry, whatever the step; use a smaller external force or weaker gravity (below {:.1e} N on that sphere a period stays within the reach; the paper's swimmers weigh about 1e-14 N)",
-            k / 2,
+            self.owner(k),
             reach / (period * mobility)
         ))
     }

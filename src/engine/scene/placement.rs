@@ -135,17 +135,14 @@ impl Scene {
     /// earlier swimmer, where the scene holds it), the first swimmer it overlaps, and the gap
     /// `add` would name.
     fn first_overlap(&self, old: usize, dirs: &[Vector3<f64>]) -> Option<(usize, usize, f64)> {
-        let total = self.count();
-        let (mut x, mut y, mut z) = (
-            vec![0.0; 2 * total],
-            vec![0.0; 2 * total],
-            vec![0.0; 2 * total],
-        );
-        let mut radii = Vec::with_capacity(2 * total);
+        let (total, per) = (self.count(), self.swimmer_model().spheres_per_swimmer());
+        let spheres = self.sphere_count();
+        let (mut x, mut y, mut z) = (vec![0.0; spheres], vec![0.0; spheres], vec![0.0; spheres]);
+        let mut radii = Vec::with_capacity(spheres);
         for i in 0..total {
             let (x1, x2) = self.spheres(i);
             for (k, p) in [x1, x2].into_iter().enumerate() {
-                (x[2 * i + k], y[2 * i + k], z[2 * i + k]) = (p.x, p.y, p.z);
+                (x[per * i + k], y[per * i + k], z[per * i + k]) = (p.x, p.y, p.z);
             }
             radii.extend([self.swimmers[i].a1, self.swimmers[i].a2]);
         }
@@ -168,8 +165,8 @@ impl Scene {
             let mut first: Option<usize> = None;
             for &(p, a) in &mine {
                 let mut check = |j: usize| {
-                    if !clear(gap(p, a, j), 0.0) && first.is_none_or(|s| j / 2 < s) {
-                        first = Some(j / 2);
+                    if !clear(gap(p, a, j), 0.0) && first.is_none_or(|s| self.owner(j) < s) {
+                        first = Some(self.owner(j));
                     }
                 };
                 match &grid {
@@ -179,21 +176,21 @@ impl Scene {
                             // A run holds its points in ascending order: the earlier swimmers'
                             // spheres come first.
                             for &j in &g.order[from as usize..to as usize] {
-                                if j as usize >= 2 * swimmer {
+                                if j as usize >= per * swimmer {
                                     break;
                                 }
                                 check(j as usize);
                             }
                         }
                     }
-                    None => (0..2 * swimmer).for_each(check),
+                    None => (0..per * swimmer).for_each(check),
                 }
             }
             if let Some(s) = first {
                 // The gap `add` names: the first overlapping pair in its order.
                 let named = mine
                     .iter()
-                    .flat_map(|&(p, a)| [2 * s, 2 * s + 1].map(|j| gap(p, a, j)))
+                    .flat_map(|&(p, a)| (per * s..per * (s + 1)).map(move |j| gap(p, a, j)))
                     .find(|&g| !clear(g, 0.0))
                     .unwrap_or(f64::NAN);
                 return Some((k, s, named));
@@ -273,7 +270,10 @@ impl Scene {
     /// The smallest gap |x_α − x_β| − a_α − a_β over all pairs of spheres (m) and the two spheres
     /// (sphere α belongs to swimmer α/2, the a1 sphere first); `None` with fewer than two spheres.
     pub fn closest_spheres(&self) -> Option<(f64, usize, usize)> {
-        let n = 2 * self.count();
+        let (n, per) = (
+            self.sphere_count(),
+            self.swimmer_model().spheres_per_swimmer(),
+        );
         let mut soa = crate::engine::pairs::SoaSpheres::default();
         soa.resize(n);
         soa.periodic = self.periodic().copied();
@@ -282,7 +282,7 @@ impl Scene {
             let (a, b) = self.spheres(i);
             let d = &self.swimmers[i];
             for (k, (p, r)) in [(a, d.a1), (b, d.a2)].into_iter().enumerate() {
-                let j = 2 * i + k;
+                let j = per * i + k;
                 (soa.x[j], soa.y[j], soa.z[j]) = (p.x, p.y, p.z);
                 radii.push(r);
             }

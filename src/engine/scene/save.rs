@@ -240,31 +240,16 @@ impl Scene {
         if let Some(extent) = Extent::of(&self.swimmers) {
             self.geometry().check_cell(&extent)?;
         }
+        let model = self.swimmer_model();
         for i in 0..self.count() {
-            let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
-            let len = v.norm();
-            match self.model {
-                Model::Micro if len <= 0.0 => {
-                    return Err(invalid!(
-                        "swimmer {i}: its dumbbell vector X2 - X1 is zero; a dumbbell needs two distinct spheres"
-                    ))
-                }
-                Model::Averaged | Model::Rigid if (len - 1.0).abs() > 1e-9 => {
-                    return Err(invalid!(
-                        "swimmer {i}: its orientation N has length {len}, not 1; in the {} model the state holds the unit vector N",
-                        self.model.name()
-                    ))
-                }
-                _ => {}
-            }
+            model.check_vector(i, &vec3(&self.state, STATE_PER_SWIMMER * i + 3))?;
         }
         if let Some((gap, a, b)) = self.closest_spheres() {
-            let same = a / 2 == b / 2;
+            let (sa, sb) = (self.owner(a), self.owner(b));
+            let same = sa == sb;
             if gap <= 0.0 && (same || !self.contacts.allow_overlap) {
                 return Err(invalid!(
-                    "spheres {a} and {b} (swimmers {} and {}) overlap by {:.3e} m; move them apart{}",
-                    a / 2,
-                    b / 2,
+                    "spheres {a} and {b} (swimmers {sa} and {sb}) overlap by {:.3e} m; move them apart{}",
                     -gap,
                     if same { "" } else { ", or allow overlaps (\"overlaps\": allow)" }
                 ));

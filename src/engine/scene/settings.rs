@@ -28,13 +28,11 @@ impl Scene {
         if model == self.model {
             return;
         }
+        let target = models::of(model);
         for (s, d) in self.swimmers.iter().enumerate() {
             let i = STATE_PER_SWIMMER * s + 3;
             let v = vec3(&self.state, i);
-            let new = match model {
-                Model::Averaged | Model::Rigid => v.normalize(),
-                Model::Micro => v * d.rest_length(self.time),
-            };
+            let new = target.converted_vector(&v, d.rest_length(self.time));
             set_vec3(&mut self.state, i, &new);
         }
         self.model = model;

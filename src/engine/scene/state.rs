@@ -16,10 +16,7 @@ impl Scene {
         let len = d.rest_length(self.time);
         self.swimmers.push(d);
         self.base.push(center);
-        let v = match self.model {
-            Model::Micro => n * len,
-            Model::Averaged | Model::Rigid => n,
-        };
+        let v = self.swimmer_model().initial_vector(&n, len);
         self.state
             .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
         self.swimmers.len() - 1
@@ -28,10 +25,7 @@ impl Scene {
     /// The length at which swimmer `d`'s spheres sit now: L(t), or ℓ in the averaged model, whose
     /// swimmers are stroke-averaged (its contact guard and steric repulsion use ℓ too).
     pub(in crate::engine) fn contact_length(&self, d: &Dumbbell) -> f64 {
-        match self.model {
-            Model::Averaged => d.ell,
-            Model::Micro | Model::Rigid => d.rest_length(self.time),
-        }
+        self.swimmer_model().contact_length(d, self.time)
     }
 
     /// Set the stroke phase φ of swimmer `i` (rad). Where the phase places the spheres (the
@@ -76,6 +70,21 @@ impl Scene {
     /// Number of swimmers.
     pub fn count(&self) -> usize {
         self.swimmers.len()
+    }
+
+    /// The implementation of the model in use.
+    pub(crate) fn swimmer_model(&self) -> &'static dyn SwimmerModel {
+        models::of(self.model)
+    }
+
+    /// Number of spheres: the model's spheres per swimmer, swimmer by swimmer.
+    pub fn sphere_count(&self) -> usize {
+        self.swimmer_model().spheres_per_swimmer() * self.count()
+    }
+
+    /// The swimmer sphere `k` belongs to.
+    pub(crate) fn owner(&self, k: usize) -> usize {
+        k / self.swimmer_model().spheres_per_swimmer()
     }
 
     /// Current time (s).
@@ -137,10 +146,10 @@ impl Scene {
     /// Current length |X₂ − X₁| of swimmer `i` (m); in the averaged model its rest length L(t).
     pub fn length(&self, i: usize) -> Result<f64> {
         self.check_index(i)?;
-        Ok(match self.model {
-            Model::Micro => vec3(&self.state, STATE_PER_SWIMMER * i + 3).norm(),
-            Model::Averaged | Model::Rigid => self.swimmers[i].rest_length(self.time),
-        })
+        let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
+        Ok(self
+            .swimmer_model()
+            .length(&self.swimmers[i], &v, self.time))
     }
 
     /// Sphere velocities (m/s) for given sphere forces (N), one per sphere, swimmer by swimmer
@@ -148,7 +157,7 @@ impl Scene {
     /// positions: v_α = F_α/(6πμa_α) + Σ_{β≠α} H_αβ F_β; in a box the periodic mobility (Ewald
     /// sums, no net flow). For checks against other codes.
     pub fn sphere_velocities(&self, forces: &[Vector3<f64>]) -> Result<Vec<Vector3<f64>>> {
-        let n = 2 * self.count();
+        let n = self.sphere_count();
         if forces.len() != n {
             return Err(invalid!(
                 "sphere velocities need one force per sphere: {n} for {} swimmers (two spheres each, the a1 sphere first), got {}",
@@ -183,10 +192,7 @@ impl Scene {
         let d = &self.swimmers[i];
         let rh = self.base[i] + vec3(&self.state, STATE_PER_SWIMMER * i);
         let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
-        match self.model {
-            Model::Micro => (rh - d.w2() * v, rh + d.w1() * v),
-            Model::Averaged | Model::Rigid => d.sphere_positions(rh, v, self.contact_length(d)),
-        }
+        self.swimmer_model().sphere_positions(d, rh, v, self.time)
     }
 
     /// Sphere centres of swimmer `i` as shown (snapshots, trajectories): in a box moved with its
