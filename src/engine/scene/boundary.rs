@@ -41,7 +41,7 @@ impl Scene {
     }
 
     /// Put a no-slip wall below the fluid, or (`None`) take it away. Every sphere must lie clear
-    /// above it, its height within [`Scene::reach`], and a periodic box is refused (no images of
+    /// above it, its height within the reach of positions, and a periodic box is refused (no images of
     /// the wall); otherwise the scene is unchanged and the error says which.
     pub fn set_wall(&mut self, wall: Option<Wall>) -> Result<()> {
         let Some(w) = wall else {

@@ -45,7 +45,7 @@ impl Scene {
         )
     }
 
-    /// The state vector (see [`super::model`]) and the base positions: for tests and savers.
+    /// The state vector (see [`crate::engine::model`]) and the base positions: for tests and savers.
     pub fn raw_state(&self) -> (&[f64], &[Vector3<f64>]) {
         (&self.state, &self.base)
     }

@@ -84,7 +84,7 @@ impl Scene {
     }
 
     /// Leave pairs further apart than `cutoff` (m) out of the averaged model's sums; `None`: keep
-    /// every pair (the default). The error this makes is bounded in [`AveragedSystem`].
+    /// every pair (the default). The error this makes is bounded in [`crate::engine::averaged::AveragedSystem`].
     pub fn set_cutoff(&mut self, cutoff: Option<f64>) -> Result<()> {
         if let Some(c) = cutoff {
             if !(c.is_finite() && c > 0.0) {
