@@ -4,7 +4,7 @@
 
 use super::error::{invalid, EngineError, Result};
 use super::integrators::{require_resolvable, Horizon};
-use super::model::{vec3, Model, STATE_PER_SWIMMER};
+use super::model::{vec3, STATE_PER_SWIMMER};
 use super::plan::plan;
 use super::scene::{Scene, MAX_TIME_IN_PERIODS};
 use super::stepping::{advance_cpu, advance_gpu, RunControl, Workspace};
@@ -102,7 +102,7 @@ impl<'a> Probe<'a> {
     /// divided by T.
     pub fn center_velocities(&mut self, s: &Scene) -> Result<Vec<Vector3<f64>>> {
         let n = s.count();
-        if s.model() == Model::Averaged {
+        if s.swimmer_model().stroke_averaged() {
             let mut sys = s.system()?;
             let (state, _) = s.raw_state();
             let mut dy = vec![0.0; state.len()];

@@ -229,7 +229,7 @@ fn place_in(
         let (x1, x2) = new.sphere_positions(c, dir, scene.contact_length(&new));
         // Above a wall only places clear of it count (one sphere's stroke closes half the
         // margin of a pair).
-        let above = scene.clear_of_wall(&new, &x1, &x2, 0.5 * margin);
+        let above = scene.clear_of_boundary(&new, &x1, &x2, 0.5 * margin);
         let clear = above
             && [(x1, d.a1), (x2, d.a2)].iter().all(|&(x, a)| {
                 spheres.cells.near(x.x, x.y, x.z, |k, at| {

@@ -69,22 +69,14 @@ fn measure_crossover(model: Model) -> Crossover {
             }
         }
     };
-    let unit = if model == Model::Averaged {
-        "swimmers"
-    } else {
-        "spheres"
-    };
+    let (per_swimmer, unit) = super::models::of(model).bodies();
     // Double the size until the GPU has won at two sizes in a row, or a CPU step takes longer
     // than the calibration budget.
     let mut points: Vec<(f64, f64, f64)> = Vec::new();
     let mut size = 16usize;
     let mut streak_start = None;
     loop {
-        let swimmers = if model == Model::Averaged {
-            size
-        } else {
-            size / 2
-        };
+        let swimmers = size / per_swimmer;
         let (cpu, gpu) = match (
             step_time(model, Backend::Cpu, swimmers),
             step_time(model, Backend::Gpu, swimmers),

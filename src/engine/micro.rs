@@ -7,13 +7,19 @@
 //!   because the dumbbell is force-free, so they are never added (no cancellation in floating point);
 //! - db/dt = −f (1/γ₁ + 1/γ₂) + u₂ − u₁, γ = 6πμa.
 
+use super::boundary::Boundary;
 use super::contacts::Contacts;
-use super::integrators::{Noise, OdeSystem, Problem, Reach};
+use super::error::{self, invalid};
+use super::integrators::{
+    noisy_euler, IntegratorSpec, Noise, OdeSystem, Problem, Reach, DEFAULT_AUTO_TOL,
+};
 use super::mobility::{self_mobility, Mobility};
-use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
+use super::model::{
+    set_vec3, vec3, DeviceKernel, Model, SceneView, SwimmerModel, STATE_PER_SWIMMER,
+};
 use super::spheres::Spheres;
 use super::swimmer::{shortest_period, Dumbbell};
-use super::thermal::{lanczos, Thermal};
+use super::thermal::{lanczos, NoiseRoot, Thermal};
 use nalgebra::{DMatrix, Vector3};
 
 /// The microscopic right-hand side with its scratch buffers.
@@ -70,11 +76,15 @@ impl MicroSystem {
         }
     }
 
-    /// Take `operator` as the boundary's mobility (open space until set). The stiff own-pair
-    /// rates behind rosw's Jacobian stay open space's: a W-method needs only an approximate
-    /// Jacobian, and a box longer than the swimmer changes the own pair little.
-    pub fn set_mobility(&mut self, operator: Box<dyn crate::engine::mobility::MobilityOperator>) {
-        self.spheres.set_mobility(operator);
+    /// Put the spheres in `boundary`, whose mobility is `operator` (open space until set). The
+    /// stiff own-pair rates behind rosw's Jacobian stay open space's: a W-method needs only an
+    /// approximate Jacobian, and a box longer than the swimmer changes the own pair little.
+    pub fn set_boundary(
+        &mut self,
+        boundary: Boundary,
+        operator: Box<dyn crate::engine::mobility::MobilityOperator>,
+    ) {
+        self.spheres.set_boundary(boundary, operator);
     }
 
     /// The constant external force on every sphere (N; none when empty).
@@ -335,6 +345,113 @@ impl OdeSystem for MicroSystem {
             Some(p) => Err(p),
             None => Ok(()),
         }
+    }
+}
+
+/// The spring model's answers to the model seam: its state holds the dumbbell vector
+/// b = X₂ − X₁, the springs are stiff, and the device runs it.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Springs;
+
+impl SwimmerModel for Springs {
+    fn choice(&self) -> Model {
+        Model::Micro
+    }
+
+    fn initial_vector(&self, n: &Vector3<f64>, len: f64) -> Vector3<f64> {
+        n * len
+    }
+
+    fn converted_vector(&self, v: &Vector3<f64>, len: f64) -> Vector3<f64> {
+        v * len
+    }
+
+    fn check_vector(&self, i: usize, v: &Vector3<f64>) -> error::Result<()> {
+        if v.norm() <= 0.0 {
+            return Err(invalid!(
+                "swimmer {i}: its dumbbell vector X2 - X1 is zero; a dumbbell needs two distinct spheres"
+            ));
+        }
+        Ok(())
+    }
+
+    fn length(&self, _d: &Dumbbell, v: &Vector3<f64>, _t: f64) -> f64 {
+        v.norm()
+    }
+
+    fn sphere_positions(
+        &self,
+        d: &Dumbbell,
+        rh: Vector3<f64>,
+        v: Vector3<f64>,
+        _t: f64,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        (rh - d.w2() * v, rh + d.w1() * v)
+    }
+
+    /// The orientation's spin from b's rate: its part across b, over |b|.
+    fn spin(&self, v: &Vector3<f64>, w: Vector3<f64>) -> Vector3<f64> {
+        let n = v.normalize();
+        (w - n * n.dot(&w)) / v.norm()
+    }
+
+    fn system(&self, s: &dyn SceneView) -> error::Result<Box<dyn OdeSystem>> {
+        let mut sys = MicroSystem::new(s.swimmers(), s.base(), s.mu(), s.mobility(), s.contacts());
+        sys.set_thermal(s.thermal());
+        sys.set_boundary(*s.boundary(), s.mobility_operator_by(s.ewald_method())?);
+        sys.set_external(s.sphere_forces());
+        sys.set_reach(s.reach());
+        Ok(Box::new(sys))
+    }
+
+    /// The spring tension k0 (|b| − L).
+    fn tension(&self, s: &dyn SceneView, i: usize) -> error::Result<f64> {
+        let d = &s.swimmers()[i];
+        let len = vec3(s.state(), STATE_PER_SWIMMER * i + 3).norm();
+        Ok(d.k0 * (len - d.rest_length(s.time())))
+    }
+
+    /// `auto(tol)` at [`DEFAULT_AUTO_TOL`]; on the gpu backend, which steps the explicit
+    /// methods only, RK4 at the default step.
+    fn default_integrator(&self, s: &dyn SceneView) -> IntegratorSpec {
+        if s.on_gpu() {
+            IntegratorSpec::Rk4 {
+                dt: s.facts().rk4_step(),
+            }
+        } else {
+            IntegratorSpec::Auto {
+                tol: DEFAULT_AUTO_TOL,
+            }
+        }
+    }
+
+    fn default_noisy_integrator(&self, s: &dyn SceneView) -> IntegratorSpec {
+        noisy_euler(s.facts().noisy_spring_step())
+    }
+
+    /// RK4 at the step of the tolerance, or rosw where the springs are stiff.
+    fn stroboscopic_inner(&self, s: &dyn SceneView, tol: f64) -> IntegratorSpec {
+        let facts = s.facts();
+        if facts.stiff() {
+            IntegratorSpec::Rosw {
+                rtol: (tol * 1e-2).clamp(1e-12, 1e-6),
+            }
+        } else {
+            facts.rk4_inner(tol)
+        }
+    }
+
+    fn settling_periods(&self, s: &dyn SceneView, period: f64) -> u32 {
+        s.facts().spring_settling_periods(period)
+    }
+
+    fn dense_noise_spheres(&self, root: NoiseRoot, swimmers: usize) -> Option<usize> {
+        let spheres = self.spheres_per_swimmer() * swimmers;
+        root.dense_for(spheres).then_some(spheres)
+    }
+
+    fn device_kernel(&self) -> std::result::Result<DeviceKernel, (&'static str, &'static str)> {
+        Ok(DeviceKernel::Springs)
     }
 }
 

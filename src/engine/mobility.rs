@@ -7,7 +7,6 @@
 //! (the hydrodynamic centre is the centre of friction), instead of cancelling them in floating point.
 
 use super::choice::{self, Choice, Named};
-use super::periodic::PeriodicBox;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -108,20 +107,13 @@ impl Mobility {
 
     /// The full 3N×3N mobility matrix including self terms (for tests and small systems).
     pub fn matrix(self, mu: f64, pos: &[Vector3<f64>], radii: &[f64]) -> DMatrix<f64> {
-        let n = pos.len();
-        let mut m = DMatrix::zeros(3 * n, 3 * n);
-        for a in 0..n {
-            for i in 0..3 {
-                m[(3 * a + i, 3 * a + i)] = 1.0 / (6.0 * PI * mu * radii[a]);
+        block_matrix(pos.len(), Blocks::Each, |a, b| {
+            if a == b {
+                Matrix3::identity() * (1.0 / (6.0 * PI * mu * radii[a]))
+            } else {
+                self.pair_tensor(mu, &(pos[a] - pos[b]), radii[a], radii[b])
             }
-            for b in 0..n {
-                if a != b {
-                    let h = self.pair_tensor(mu, &(pos[a] - pos[b]), radii[a], radii[b]);
-                    m.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&h);
-                }
-            }
-        }
-        m
+        })
     }
 
     /// Interaction velocities u_α = Σ_{β≠α} H_αβ F_β (self drag excluded), all pairs, O(N²).
@@ -148,15 +140,49 @@ impl Mobility {
     }
 }
 
+/// Which blocks of a symmetric block matrix [`block_matrix`] computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Blocks {
+    /// Every block M_ab on its own.
+    Each,
+    /// The blocks on and above the diagonal; those below are their transposes, M_ba = M_abᵀ.
+    Upper,
+}
+
+/// The 3N×3N matrix of the N×N blocks `block(a, b)` (3×3 each), computed as `blocks` says.
+pub fn block_matrix(
+    n: usize,
+    blocks: Blocks,
+    block: impl Fn(usize, usize) -> Matrix3<f64>,
+) -> DMatrix<f64> {
+    let mut m = DMatrix::zeros(3 * n, 3 * n);
+    for a in 0..n {
+        let first = match blocks {
+            Blocks::Each => 0,
+            Blocks::Upper => a,
+        };
+        for b in first..n {
+            let h = block(a, b);
+            m.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&h);
+            if blocks == Blocks::Upper && a != b {
+                m.fixed_view_mut::<3, 3>(3 * b, 3 * a)
+                    .copy_from(&h.transpose());
+            }
+        }
+    }
+    m
+}
+
 /// Stokes drag mobility of one sphere, 1/(6πμa).
 #[inline]
 pub fn self_mobility(mu: f64, a: f64) -> f64 {
     1.0 / (6.0 * PI * mu * a)
 }
 
-/// The mobility of a set of spheres in one boundary (open space, a periodic box): how the forces
-/// on the spheres become their velocities. Built once where the scene's settings change and
-/// owned by the sphere models; each boundary is one implementation.
+/// The mobility of a set of spheres in one boundary (open space, a periodic box, a wall): how the
+/// forces on the spheres become their velocities. Built once where the scene's settings change
+/// and owned by the sphere models; each boundary is one implementation (what is solid and how
+/// separations are measured is the boundary's geometry, not the mobility's).
 ///
 /// Every boundary splits its mobility as M = D + W: D the free Stokes drag 1/(6πμa) of each
 /// sphere, which the models apply themselves (it cancels from dR_H/dt exactly), and W all the
@@ -193,34 +219,6 @@ pub trait MobilityOperator: std::fmt::Debug + Send + Sync {
     /// boundary's settings leave the drift out.
     fn divergence(&self, _pos: &[Vector3<f64>], _radii: &[f64], _out: &mut [Vector3<f64>]) -> bool {
         false
-    }
-
-    /// Whether the boundary has a solid part (a wall) that repels spheres and that they must not
-    /// reach.
-    fn solid(&self) -> bool {
-        false
-    }
-
-    /// The sphere closest to a solid boundary and the gap between its surface and the boundary
-    /// (m); `None` where the boundary has no solid part.
-    fn boundary_gap(&self, _pos: &[Vector3<f64>], _radii: &[f64]) -> Option<(usize, f64)> {
-        None
-    }
-
-    /// Add the solid boundary's repulsion on each sphere to `forces`; `false` (nothing added)
-    /// where the boundary has no solid part.
-    fn add_boundary_forces(
-        &self,
-        _pos: &[Vector3<f64>],
-        _radii: &[f64],
-        _forces: &mut [Vector3<f64>],
-    ) -> bool {
-        false
-    }
-
-    /// The periodic box, when the boundary is one (minimum images, gaps).
-    fn periodic(&self) -> Option<&PeriodicBox> {
-        None
     }
 
     /// A copy behind a box (the models are cloned with their scenes).

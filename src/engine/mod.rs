@@ -8,6 +8,7 @@
 pub mod advance;
 pub mod averaged;
 pub mod backend;
+pub mod boundary;
 pub mod build;
 pub mod calibrate;
 pub mod cells;
@@ -26,6 +27,7 @@ pub mod integrators;
 pub mod micro;
 pub mod mobility;
 pub mod model;
+pub mod models;
 pub mod neighbours;
 pub mod observable;
 pub mod open_space;

@@ -4,7 +4,6 @@
 use super::advance::Probe;
 use super::error::Result;
 use super::fields::{Field, FieldKind, FieldSpec, FieldStat};
-use super::periodic::separation;
 use super::scene::Scene;
 use super::stepping::{RunControl, Workspace};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
@@ -213,7 +212,7 @@ impl Observable {
         if matches!(
             self,
             Observable::WallGap | Observable::Height(_) | Observable::WallAngle(_)
-        ) && scene.wall().is_none()
+        ) && scene.geometry().floor().is_none()
         {
             return Err(super::error::invalid!(
                 "{} is measured from the wall, and this scene has none; give the scene a wall first (a plane at height z, m)",
@@ -281,7 +280,7 @@ impl Observable {
             }
             Observable::Q(i, j) => vec![s.dir(i)?.dot(&s.dir(j)?)],
             Observable::DistanceH(i, j) => {
-                vec![separation(s.periodic(), s.center(i)? - s.center(j)?).norm()]
+                vec![s.geometry().separation(s.center(i)? - s.center(j)?).norm()]
             }
             Observable::DeltaQ(i, j) => {
                 let q = Observable::Q(i, j);
@@ -345,7 +344,7 @@ impl Observable {
         let mut quiet = s.clone();
         quiet.set_temperature(0.0)?;
         quiet.set_integrator(None);
-        if quiet.model() != super::model::Model::Averaged {
+        if !quiet.swimmer_model().stroke_averaged() {
             // A noisy state lies off the stroke's cycle by the thermal spring fluctuation, whose
             // relaxation moves R_H (the dumbbell's own spheres interact) by far more than a
             // period's drift: relax for one period first.
@@ -372,11 +371,11 @@ impl Observable {
             .map(|i| s.center(i))
             .collect::<Result<Vec<_>>>()?;
         let width = r_max / bins as f64;
-        let periodic = s.periodic();
+        let g = s.geometry();
         let row = |i: usize| {
             let mut h = vec![0.0; bins];
             for cj in &c[i + 1..] {
-                let k = (separation(periodic, c[i] - cj).norm() / width) as usize;
+                let k = (g.separation(c[i] - cj).norm() / width) as usize;
                 if k < bins {
                     h[k] += 1.0;
                 }
@@ -400,20 +399,18 @@ impl Observable {
 
     /// The wall's height (checked to exist by [`Observable::check`]).
     fn wall_z(s: &Scene) -> f64 {
-        s.wall().map_or(0.0, |w| w.z)
+        s.geometry().floor().unwrap_or(0.0)
     }
 
     /// The smallest gap between a sphere and the wall (m); [`Observable::check`] makes sure there
     /// are both.
     fn wall_gap(s: &Scene) -> f64 {
-        let Some(w) = s.wall() else {
-            return f64::INFINITY;
-        };
+        let g = s.geometry();
         (0..s.count())
             .flat_map(|i| {
                 let (x1, x2) = s.spheres(i);
                 let d = s.swimmers()[i];
-                [w.gap(&x1, d.a1), w.gap(&x2, d.a2)]
+                [g.gap(&x1, d.a1), g.gap(&x2, d.a2)]
             })
             .fold(f64::INFINITY, f64::min)
     }

@@ -4,7 +4,6 @@
 use super::backend::Backend;
 use super::calibrate;
 use super::error::{unsupported, Result, Setting};
-use super::model::Model;
 use super::scene::Scene;
 
 /// Which backend the next run of `s` takes, and why.
@@ -63,10 +62,8 @@ pub fn plan(s: &Scene) -> Result<Plan> {
                 Ok(d) => d,
                 Err(e) => return cpu(format!("auto: {e}")),
             };
-            let (size, unit) = match s.model() {
-                Model::Averaged => (s.count(), "swimmers"),
-                _ => (2 * s.count(), "spheres"),
-            };
+            let (per_swimmer, unit) = s.swimmer_model().bodies();
+            let size = per_swimmer * s.count();
             let c = calibrate::crossover(s.model());
             Ok(match c.size {
                 Some(n) if size >= n => Plan {

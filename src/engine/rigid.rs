@@ -12,10 +12,17 @@
 //! and dN/dt = (I − NNᵀ)(u₂ − u₁)/L, u the interaction velocities. Nothing is stiff any more: the
 //! step is set by the stroke, not by the spring.
 
+use super::boundary::Boundary;
 use super::contacts::Contacts;
-use super::integrators::{OdeSystem, Problem, Reach};
+use super::error::{self, unsupported, EngineError, Setting};
+use super::ewald::EwaldMethod;
+use super::integrators::{
+    IntegratorSpec, OdeSystem, Problem, Reach, DEFAULT_AUTO_TOL, DEFAULT_RIGID_RTOL,
+};
 use super::mobility::Mobility;
-use super::model::{set_vec3, vec3, STATE_PER_SWIMMER};
+use super::model::{
+    set_vec3, vec3, DeviceKernel, Model, SceneView, SwimmerModel, STATE_PER_SWIMMER,
+};
 use super::spheres::Spheres;
 use super::swimmer::{shortest_period, Dumbbell};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -87,9 +94,13 @@ impl RigidSystem {
         self.spheres.set_external(external);
     }
 
-    /// Take `operator` as the boundary's mobility (open space until set).
-    pub fn set_mobility(&mut self, operator: Box<dyn crate::engine::mobility::MobilityOperator>) {
-        self.spheres.set_mobility(operator);
+    /// Put the spheres in `boundary`, whose mobility is `operator` (open space until set).
+    pub fn set_boundary(
+        &mut self,
+        boundary: Boundary,
+        operator: Box<dyn crate::engine::mobility::MobilityOperator>,
+    ) {
+        self.spheres.set_boundary(boundary, operator);
     }
 
     /// The constraint tensions at time `t` (N), in swimmer order.
@@ -223,6 +234,92 @@ fn solve_in_place(a: &mut DMatrix<f64>, b: &mut DVector<f64>) -> bool {
         b[row] = acc / a[(row, row)];
     }
     true
+}
+
+/// The rigid-stroke model's answers to the model seam: its state holds the unit orientation N,
+/// its constraint solve takes blocks (Beenakker's sums in a box) and dumbbell tensions only, and
+/// it runs on the CPU.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RigidStrokes;
+
+/// The rigid-stroke system of scene `s` (steric repulsion aside, which [`RigidStrokes`] refuses):
+/// the one every run and the tensions use.
+fn rigid_system(s: &dyn SceneView) -> error::Result<RigidSystem> {
+    let mut sys = RigidSystem::new(
+        s.swimmers(),
+        s.base(),
+        s.mu(),
+        s.mobility(),
+        s.contacts().allow_overlap,
+    );
+    // The constraint solve takes blocks, which are Beenakker's sums.
+    sys.set_boundary(
+        *s.boundary(),
+        s.mobility_operator_by(EwaldMethod::Beenakker)?,
+    );
+    sys.set_external(s.sphere_forces());
+    sys.set_reach(s.reach());
+    Ok(sys)
+}
+
+impl SwimmerModel for RigidStrokes {
+    fn choice(&self) -> Model {
+        Model::Rigid
+    }
+
+    fn system(&self, s: &dyn SceneView) -> error::Result<Box<dyn OdeSystem>> {
+        if s.contacts().steric.is_some() {
+            return Err(unsupported(
+                "steric repulsion is not available in the rigid-stroke model (its constraint solve takes dumbbell tensions only)",
+                &[Setting::Model("micro"), Setting::Model("averaged"), Setting::NoSteric],
+            ));
+        }
+        Ok(Box::new(rigid_system(s)?))
+    }
+
+    /// The constraint tension of the S×S solve.
+    fn tension(&self, s: &dyn SceneView, i: usize) -> error::Result<f64> {
+        Ok(rigid_system(s)?.tensions(s.time(), s.state())[i])
+    }
+
+    fn ewald_method(&self, _set: EwaldMethod) -> Option<EwaldMethod> {
+        Some(EwaldMethod::Beenakker)
+    }
+
+    fn default_integrator(&self, _s: &dyn SceneView) -> IntegratorSpec {
+        IntegratorSpec::Auto {
+            tol: DEFAULT_AUTO_TOL,
+        }
+    }
+
+    /// Its default: the model refuses noise when it runs.
+    fn default_noisy_integrator(&self, _s: &dyn SceneView) -> IntegratorSpec {
+        IntegratorSpec::Dopri5 {
+            rtol: DEFAULT_RIGID_RTOL,
+        }
+    }
+
+    /// dopri5 a hundred times tighter than `tol` (its step choice makes the map only piecewise
+    /// smooth, at the level of its tolerance).
+    fn stroboscopic_inner(&self, _s: &dyn SceneView, tol: f64) -> IntegratorSpec {
+        IntegratorSpec::Dopri5 {
+            rtol: (tol * 1e-2).clamp(1e-12, DEFAULT_RIGID_RTOL),
+        }
+    }
+
+    fn refuses_noise(&self, t: f64) -> Option<EngineError> {
+        Some(unsupported(
+            format!("thermal noise (temperature {t} K) is not available in the rigid-stroke model: Brownian motion under a rigid constraint needs the metric (Fixman) drift, which changes the equilibrium this model would sample"),
+            &[Setting::Model("micro"), Setting::Model("averaged"), Setting::NoNoise],
+        ))
+    }
+
+    fn device_kernel(&self) -> std::result::Result<DeviceKernel, (&'static str, &'static str)> {
+        Err((
+            "the rigid-stroke model",
+            "its per-swimmer stroke solve has no GPU kernel",
+        ))
+    }
 }
 
 #[cfg(test)]

@@ -2,12 +2,12 @@
 //! them: radii, positions, the force on each, and the interaction velocities the mobility gives.
 //! Sphere 2σ is dumbbell σ's a1 sphere, 2σ+1 its a2 sphere.
 
+use super::boundary::Boundary;
 use super::contacts::Contacts;
 use super::integrators::Problem;
 use super::mobility::{self_mobility, Mobility, MobilityOperator};
 use super::open_space::{OpenSpace, FAST_KERNEL_SPHERES, PARALLEL_SPHERES};
 use super::pairs::SoaSpheres;
-use super::periodic::{separation, PeriodicBox};
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
 
@@ -30,16 +30,16 @@ pub(crate) struct Spheres {
     body: Vec<Vector3<f64>>,
     /// The constant external force on every sphere (N; empty when none).
     external: Vec<Vector3<f64>>,
-    /// Whether the boundary repels spheres (a wall).
-    boundary_forces: bool,
+    /// Open space, a periodic box (whose minimum images the gaps and steric forces take) or a
+    /// wall (whose repulsion joins the body forces).
+    boundary: Boundary,
     /// Scratch of the mobility's divergence.
     div: Vec<Vector3<f64>>,
     contacts: Contacts,
     u: Vec<Vector3<f64>>,
     /// Scratch of the gap passes (large scenes).
     soa: SoaSpheres,
-    /// The boundary's mobility: open space, or a periodic box's Ewald sums (whose box also sets
-    /// the minimum images).
+    /// The boundary's mobility: open space's pairs, a periodic box's Ewald sums, or a wall's.
     operator: Box<dyn MobilityOperator>,
 }
 
@@ -61,7 +61,7 @@ impl Spheres {
             spring: vec![Vector3::zeros(); swimmers.len()],
             body: Vec::new(),
             external: Vec::new(),
-            boundary_forces: false,
+            boundary: Boundary::Open,
             div: Vec::new(),
             contacts,
             u: vec![Vector3::zeros(); n],
@@ -70,10 +70,10 @@ impl Spheres {
         }
     }
 
-    /// Take `operator` as the boundary's mobility (open space until set).
-    pub(crate) fn set_mobility(&mut self, operator: Box<dyn MobilityOperator>) {
-        self.soa.periodic = operator.periodic().copied();
-        self.boundary_forces = operator.solid();
+    /// Put the spheres in `boundary`, whose mobility is `operator` (open space until set).
+    pub(crate) fn set_boundary(&mut self, boundary: Boundary, operator: Box<dyn MobilityOperator>) {
+        self.soa.periodic = boundary.periodic().copied();
+        self.boundary = boundary;
         self.operator = operator;
     }
 
@@ -84,7 +84,9 @@ impl Spheres {
 
     /// Whether some sphere carries a force that no dumbbell balances.
     fn has_body_forces(&self) -> bool {
-        self.contacts.steric.is_some() || self.boundary_forces || !self.external.is_empty()
+        self.contacts.steric.is_some()
+            || self.boundary.geometry().solid()
+            || !self.external.is_empty()
     }
 
     /// The forces of [`Spheres::body`] at the current positions.
@@ -102,13 +104,14 @@ impl Spheres {
             st.add_forces(
                 &self.pos,
                 &self.radii,
-                self.operator.periodic(),
+                self.boundary.periodic(),
                 &mut self.body,
                 n >= PARALLEL_SPHERES,
             );
         }
-        self.operator
-            .add_boundary_forces(&self.pos, &self.radii, &mut self.body);
+        self.boundary
+            .geometry()
+            .add_forces(&self.pos, &self.radii, &mut self.body);
     }
 
     /// The velocities the body forces alone give every sphere, M F^b, self drag included, into
@@ -145,11 +148,6 @@ impl Spheres {
                 *u += d * kt;
             }
         }
-    }
-
-    /// The periodic box, if any.
-    pub(crate) fn periodic(&self) -> Option<&PeriodicBox> {
-        self.operator.periodic()
     }
 
     /// H_αβ v for spheres α, β (α = β: the self block, Stokes drag included).
@@ -229,10 +227,10 @@ impl Spheres {
     /// The first pair of overlapping spheres at the current positions, as a problem naming the
     /// swimmers; with overlaps between swimmers allowed, only a dumbbell's own spheres count.
     pub(crate) fn first_overlap(&mut self) -> Option<Problem> {
-        if let Some((a, gap)) = self.operator.boundary_gap(&self.pos, &self.radii) {
-            if gap <= 0.0 {
-                return Some(wall_problem(gap, a));
-            }
+        let owner = |a: usize| (a / 2, a % 2 + 1);
+        let g = self.boundary.geometry();
+        if let Some(p) = g.touching(&self.pos, &self.radii, &owner) {
+            return Some(p);
         }
         if self.contacts.allow_overlap {
             return (0..self.pos.len() / 2).find_map(|s| {
@@ -248,31 +246,17 @@ impl Spheres {
             return super::gaps::closest_overlap(&self.soa, &self.radii, parallel)
                 .map(|(gap, a, b)| overlap_problem(gap, a, b));
         }
-        let (pos, radii, periodic) = (&self.pos, &self.radii, self.periodic());
+        let (pos, radii) = (&self.pos, &self.radii);
         let n = pos.len();
         for a in 0..n {
             for b in (a + 1)..n {
-                let gap = separation(periodic, pos[a] - pos[b]).norm() - radii[a] - radii[b];
+                let gap = g.separation(pos[a] - pos[b]).norm() - radii[a] - radii[b];
                 if gap <= 0.0 {
                     return Some(overlap_problem(gap, a, b));
                 }
             }
         }
         None
-    }
-}
-
-/// The guard's report of sphere `a` reaching into the wall by −`gap`.
-fn wall_problem(gap: f64, a: usize) -> Problem {
-    let s = a / 2;
-    Problem {
-        swimmer: Some(s),
-        cause: format!(
-            "sphere {} of swimmer {s} touched the wall (gap {gap:.3e} m)",
-            a % 2 + 1
-        ),
-        hint: "stiffen the wall's repulsion or widen its range (the wall's stiffness and range), take a smaller time step, or start the swimmers further from the wall".into(),
-        fixes: Vec::new(),
     }
 }
 

@@ -9,7 +9,7 @@ use super::error::{invalid, unsupported, EngineError, Result, Setting};
 use super::gpu::support::{self, GpuSteps};
 use super::gpu::{AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
 use super::integrators::{uniform_steps, IntegratorSpec, Stepper};
-use super::model::Model;
+use super::model::DeviceKernel;
 use super::scene::Scene;
 use std::sync::Arc;
 
@@ -231,18 +231,18 @@ pub fn advance_gpu(
     t_end: f64,
 ) -> Result<()> {
     let (steps, tableau) = support::tableau(&s.integrator()).map_err(|e| invalid!("{e}"))?;
-    let model = match s.model() {
-        Model::Micro => GpuModel::Micro {
+    let model = match s.swimmer_model().device_kernel() {
+        Ok(DeviceKernel::Springs) => GpuModel::Micro {
             mu: s.mu(),
             mobility: s.mobility(),
         },
-        Model::Averaged => {
+        Ok(DeviceKernel::Averaged) => {
             s.check_averaged()?;
             GpuModel::Averaged {
                 coefficients: s.coefficients(),
             }
         }
-        Model::Rigid => return Err(invalid!("the rigid-stroke model runs on the CPU only")),
+        Err((who, _)) => return Err(invalid!("{who} runs on the CPU only")),
     };
     let mut run = match ws.gpu.take() {
         Some(r) if r.fits(model, s.count(), &tableau) => r,

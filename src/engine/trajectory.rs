@@ -225,7 +225,7 @@ struct Spheres {
 
 impl Spheres {
     fn of(scene: &Scene) -> Self {
-        let n = 2 * scene.count();
+        let n = scene.sphere_count();
         let mut s = Spheres {
             cell: scene.periodic().map(|b| b.sides().map(|l| l * UM)),
             pos: Vec::with_capacity(n),

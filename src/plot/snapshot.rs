@@ -5,6 +5,7 @@
 
 use super::render::{self, Disc, ScenePicture};
 use super::Format;
+use crate::engine::boundary::MAX_EXTENT_IN_RADII;
 use crate::engine::Scene;
 use plotters::style::{Color, HSLColor, RGBColor};
 use std::path::Path;
@@ -68,8 +69,10 @@ impl Default for SnapshotOptions {
 }
 
 /// The widest scene a snapshot draws, in radii of its largest sphere (a sphere of 1 µm in a
-/// scene a kilometre across).
-pub const MAX_EXTENT_IN_RADII: f64 = 1e9;
+/// scene a kilometre across): ten times the reach that the engine holds positions to
+/// ([`MAX_EXTENT_IN_RADII`], in radii of the smallest sphere), so every scene whose centres the
+/// engine holds is drawn, and only swimmers far longer than that (ℓ is unbounded) are refused.
+pub const WIDEST_IN_RADII: f64 = 10.0 * MAX_EXTENT_IN_RADII;
 
 /// Draw `scene` to `path` (SVG or PNG by extension); folders are created.
 pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<(), String> {
@@ -163,7 +166,7 @@ fn picture<'a>(scene: &Scene, opts: &'a SnapshotOptions) -> Result<ScenePicture<
         (p[depth] + q[depth]) / 2.0
     };
     order.sort_by(|&i, &j| depth_of(i).total_cmp(&depth_of(j)));
-    let mut discs = Vec::with_capacity(2 * scene.count());
+    let mut discs = Vec::with_capacity(scene.sphere_count());
     let mut rods = Vec::with_capacity(scene.count());
     for i in order {
         let (p1, p2) = scene.shown_spheres(i);
@@ -193,9 +196,9 @@ fn picture<'a>(scene: &Scene, opts: &'a SnapshotOptions) -> Result<ScenePicture<
         (f64::INFINITY, f64::NEG_INFINITY, 0.0f64),
         |(lo, hi, r), d| (lo.min(d.x.min(d.y)), hi.max(d.x.max(d.y)), r.max(d.r)),
     );
-    if !((hi - lo).is_finite() && hi - lo <= MAX_EXTENT_IN_RADII * r_max) {
+    if !((hi - lo).is_finite() && hi - lo <= WIDEST_IN_RADII * r_max) {
         return Err(format!(
-            "the swimmers span {:.3e} m in this plane, over {MAX_EXTENT_IN_RADII:e} times their largest sphere: every sphere would be below a pixel; draw a scene of the region of interest (s.copy() and fewer swimmers)",
+            "the swimmers span {:.3e} m in this plane, over {WIDEST_IN_RADII:e} times their largest sphere: every sphere would be below a pixel; draw a scene of the region of interest (s.copy() and fewer swimmers)",
             (hi - lo) / um
         ));
     }

@@ -21,11 +21,13 @@ mod implicit;
 mod lanes;
 mod list_rows;
 mod listed;
+mod model;
 mod ode;
 mod partitioned;
 mod terms;
 
 pub use implicit::{CONTACT_MARGIN_OF_RANGE, DISPLACEMENT_FLOOR, MAX_CLUSTER_SWIMMERS};
+pub use model::{check_identical, check_open, cutoff_in, StrokeAveraged};
 use ode::shared_centre_problem;
 pub(crate) use terms::pair_constants;
 use terms::{pair_weight, Coef};

@@ -18,7 +18,7 @@
 //! error e^{−π²P²/2m²} are balanced by m = 0.976√(πP) (Lindbo & Tornberg 2011), both ~e^{−πP/2}.
 //! The cost per product is O(N P³ + G log G) for G grid points, G ∝ N at a fixed density.
 
-use super::{truncation, Split};
+use super::split::{truncation, Split};
 use crate::engine::cells::CellGrid;
 use crate::engine::error::{invalid, Result};
 use crate::engine::fft3::{signed_mode, Fft3};

@@ -45,9 +45,10 @@ fn model(model: Model) -> Result<(), String> {
 /// handling, the cutoff, thermal noise.
 fn options(s: &Scene) -> Result<(), String> {
     let cpu_only = |what: &str| Err(format!("{what} runs on the CPU only"));
+    if let Some(what) = s.geometry().off_device() {
+        return cpu_only(what);
+    }
     match s.model() {
-        _ if s.periodic().is_some() => cpu_only("a periodic box (Ewald sums, minimum images)"),
-        _ if s.wall().is_some() => cpu_only("a wall (the Rotne-Prager-Blake mobility)"),
         _ if !s.external().is_none() => cpu_only("external forces and gravity"),
         _ if s.thermal().is_on() => cpu_only("thermal noise (temperature above 0)"),
         _ if s.contacts() != Contacts::default() => {

@@ -10,6 +10,7 @@
 mod dopri5;
 mod euler;
 mod philox;
+mod policy;
 mod rk4;
 mod rosenbrock;
 mod sde;
@@ -23,6 +24,12 @@ pub use dopri5::Dopri5;
 pub use dopri5::{A as DOPRI5_A, C as DOPRI5_C, E as DOPRI5_E};
 pub use euler::Euler;
 pub use philox::StepDraws;
+pub use policy::{
+    auto_choice, check_noise, noisy_euler, Facts, CHOLESKY_LIMIT_SPHERES, DEFAULT_AUTO_TOL,
+    DEFAULT_AVERAGED_RTOL, DEFAULT_MICRO_MAX_STEP_PER_PERIOD, DEFAULT_MICRO_STEP_TIMES_RATE,
+    DEFAULT_NOISY_STEP_TIMES_RATE, DEFAULT_RIGID_RTOL, DEFAULT_SUSPENSION_TOL, PLATEN_MAX_SWIMMERS,
+    RK4_DEFAULT_DRIFT_ERROR, RK4_STABLE_STEP_RATE, STIFF_STEPS_PER_PERIOD,
+};
 pub use rk4::Rk4;
 pub use rosenbrock::Rosenbrock;
 pub use sde::Platen;

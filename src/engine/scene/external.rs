@@ -1,93 +1,10 @@
-//! What acts on the swimmers from outside, and how far they may go: the wall and the external
-//! forces (gravity with buoyancy), the reach that positions and the wall are held to (where f64
-//! still resolves the spheres), and what a failed step learns from the forces.
+//! What acts on the swimmers from outside: the external forces (gravity with buoyancy), and what
+//! a failed step learns from them.
 
 use super::*;
 use crate::engine::integrators::Problem;
 
 impl Scene {
-    /// The no-slip wall, if any.
-    pub fn wall(&self) -> Option<&Wall> {
-        self.wall.as_ref()
-    }
-
-    /// Put a no-slip wall below the fluid, or (`None`) take it away. Every sphere must lie clear
-    /// above it, its height within [`Scene::reach`], and a periodic box is refused (no images of
-    /// the wall); otherwise the scene is unchanged and the error says which.
-    pub fn set_wall(&mut self, wall: Option<Wall>) -> Result<()> {
-        let Some(w) = wall else {
-            self.wall = None;
-            return Ok(());
-        };
-        let w = w.checked()?;
-        if self.periodic.is_some() {
-            return Err(unsupported(
-                "a wall in a periodic box is not available (the wall's mobility has no periodic images); leave the box first",
-                &[Setting::NoBox],
-            ));
-        }
-        self.check_wall_reach(&w)?;
-        self.check_above(&w)?;
-        self.wall = Some(w);
-        Ok(())
-    }
-
-    /// How far from the origin swimmer centres and the wall may lie: [`MAX_EXTENT_IN_RADII`]
-    /// times the smallest sphere radius, with the words that say why (unbounded without
-    /// swimmers). Placement holds the centres to it, the runs' guard each step's centres.
-    pub(crate) fn reach(&self) -> Reach {
-        let r = self
-            .swimmers
-            .iter()
-            .map(|d| d.a1.min(d.a2))
-            .fold(f64::INFINITY, f64::min);
-        if !r.is_finite() {
-            return Reach::default();
-        }
-        Reach {
-            limit: MAX_EXTENT_IN_RADII * r,
-            why: format!(
-                "{MAX_EXTENT_IN_RADII:e} times the smallest sphere radius, {r:e} m: beyond, f64 no longer resolves the spheres"
-            ),
-        }
-    }
-
-    /// Wall `w` within [`Scene::reach`]: the wall's mobility takes each sphere's image at twice
-    /// its height, whose powers overflow far beyond it (every rate NaN), and a wall that far
-    /// below the swimmers acts as none.
-    pub(in crate::engine) fn check_wall_reach(&self, w: &Wall) -> Result<()> {
-        let reach = self.reach();
-        if w.z.abs() <= reach.limit {
-            return Ok(());
-        }
-        Err(unsupported(
-            format!(
-                "the wall at z = {:e} m lies beyond the {:e} m from the origin that positions may reach ({}; the wall's mobility overflows there, and a wall that far from the swimmers acts as none); put the wall within {:e} m of the origin, just below the swimmers",
-                w.z, reach.limit, reach.why, reach.limit
-            ),
-            &[Setting::NoWall],
-        ))
-    }
-
-    /// Every sphere clear above wall `w`, or the error naming the first that is not.
-    pub(in crate::engine) fn check_above(&self, w: &Wall) -> Result<()> {
-        for i in 0..self.count() {
-            let (x1, x2) = self.spheres(i);
-            let d = &self.swimmers[i];
-            for (k, (x, a)) in [(x1, d.a1), (x2, d.a2)].into_iter().enumerate() {
-                let gap = w.gap(&x, a);
-                if gap <= 0.0 {
-                    return Err(invalid!(
-                        "sphere {} of swimmer {i} is not above the wall at z = {:e} m (its gap is {gap:.3e} m); move the swimmers up or put the wall lower",
-                        k + 1,
-                        w.z
-                    ));
-                }
-            }
-        }
-        Ok(())
-    }
-
     /// The external forces on the spheres.
     pub fn external(&self) -> ExternalForces {
         self.external
@@ -103,20 +20,6 @@ impl Scene {
     pub fn set_gravity(&mut self, gravity: Option<Gravity>) -> Result<()> {
         self.external.gravity = gravity.map(Gravity::checked).transpose()?;
         Ok(())
-    }
-
-    /// The external force on every sphere in sphere order (empty when there is none).
-    pub(crate) fn sphere_forces(&self) -> Vec<Vector3<f64>> {
-        self.external
-            .per_sphere(self.swimmers.iter().flat_map(|d| [d.a1, d.a2]))
-    }
-
-    /// Undo a change with `undo` if it left a sphere at or below the wall, and say which.
-    pub(super) fn keep_above_wall(&mut self, undo: impl FnOnce(&mut Self)) -> Result<()> {
-        let Some(w) = self.wall else {
-            return Ok(());
-        };
-        self.check_above(&w).inspect_err(|_| undo(self))
     }
 
     /// A failed step's problem with what the scene's settings tell about it: external forces that
@@ -162,7 +65,7 @@ impl Scene {
         };
         Some(format!(
             "the external forces drive sphere {k} (swimmer {}) at {speed}, its Stokes speed under {force:.3e} N, across the {reach:e} m that positions may reach in less than a stroke period ({period:.3e} s): far beyond what the swimmers can carry, whatever the step; use a smaller external force or weaker gravity (below {:.1e} N on that sphere a period stays within the reach; the paper's swimmers weigh about 1e-14 N)",
-            k / 2,
+            self.owner(k),
             reach / (period * mobility)
         ))
     }

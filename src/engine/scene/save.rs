@@ -2,11 +2,7 @@
 //! the setters check it (a file edited by hand, truncated or written by something else is refused
 //! with the value at fault).
 
-use super::super::contacts::Steric;
-use super::super::error::{invalid, require_finite, require_positive, Result};
-use super::super::model::{vec3, Model, STATE_PER_SWIMMER};
-use super::super::swimmer::Dumbbell;
-use super::Scene;
+use super::*;
 use serde::{Deserialize, Serialize};
 
 /// The latest time a scene may hold, in stroke periods: at 1e9 periods f64 still resolves the
@@ -17,9 +13,115 @@ pub const MAX_TIME_IN_PERIODS: f64 = 1e9;
 pub const SAVE_FORMAT: u32 = 1;
 
 #[derive(Serialize)]
-struct SavedScene<'a> {
+struct SavedScene {
     format: u32,
-    scene: &'a Scene,
+    scene: SceneFile,
+}
+
+/// A scene as its file holds it, field by field in the order written: the boundary as a "box"
+/// and a "wall", each saved only when set, and every value saved only when not its default
+/// where older files lack it.
+#[derive(Serialize, Deserialize)]
+#[serde(rename = "Scene")]
+struct SceneFile {
+    mu: f64,
+    model: Model,
+    mobility: Mobility,
+    coefficients: Coefficients,
+    /// Defaults for older files.
+    #[serde(default)]
+    contacts: Contacts,
+    #[serde(default)]
+    cutoff: Option<f64>,
+    integrator: Option<IntegratorSpec>,
+    swimmers: Vec<Dumbbell>,
+    base: Vec<Vector3<f64>>,
+    state: Vec<f64>,
+    time: f64,
+    stats: Stats,
+    /// "cpu" for files from before backends existed.
+    #[serde(default)]
+    backend: Backend,
+    /// Saved unless all default, so noise-free files are unchanged.
+    #[serde(default, skip_serializing_if = "Thermal::is_default")]
+    thermal: Thermal,
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    periodic: Option<PeriodicBox>,
+    #[serde(
+        default = "default_ewald_tol",
+        skip_serializing_if = "is_default_ewald_tol"
+    )]
+    ewald_tol: f64,
+    #[serde(default, skip_serializing_if = "is_auto_ewald")]
+    ewald_method: EwaldMethod,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    wall: Option<Wall>,
+    #[serde(default, skip_serializing_if = "ExternalForces::is_none")]
+    external: ExternalForces,
+}
+
+fn is_auto_ewald(m: &EwaldMethod) -> bool {
+    *m == EwaldMethod::Auto
+}
+
+fn default_ewald_tol() -> f64 {
+    DEFAULT_EWALD_TOL
+}
+
+fn is_default_ewald_tol(t: &f64) -> bool {
+    *t == DEFAULT_EWALD_TOL
+}
+
+impl SceneFile {
+    /// The file of scene `s`.
+    fn of(s: &Scene) -> Self {
+        SceneFile {
+            mu: s.mu,
+            model: s.model,
+            mobility: s.mobility,
+            coefficients: s.coefficients,
+            contacts: s.contacts,
+            cutoff: s.cutoff,
+            integrator: s.integrator,
+            swimmers: s.swimmers.clone(),
+            base: s.base.clone(),
+            state: s.state.clone(),
+            time: s.time,
+            stats: s.stats,
+            backend: s.backend,
+            thermal: s.thermal,
+            periodic: s.periodic().copied(),
+            ewald_tol: s.ewald_tol,
+            ewald_method: s.ewald_method,
+            wall: s.wall().copied(),
+            external: s.external,
+        }
+    }
+
+    /// The scene of this file in open space, and the box and wall the file gives.
+    fn into_parts(self) -> (Scene, Option<PeriodicBox>, Option<Wall>) {
+        let scene = Scene {
+            mu: self.mu,
+            model: self.model,
+            mobility: self.mobility,
+            coefficients: self.coefficients,
+            contacts: self.contacts,
+            cutoff: self.cutoff,
+            integrator: self.integrator,
+            swimmers: self.swimmers,
+            base: self.base,
+            state: self.state,
+            time: self.time,
+            stats: self.stats,
+            backend: self.backend,
+            thermal: self.thermal,
+            boundary: Boundary::Open,
+            ewald_tol: self.ewald_tol,
+            ewald_method: self.ewald_method,
+            external: self.external,
+        };
+        (scene, self.periodic, self.wall)
+    }
 }
 
 impl Scene {
@@ -39,7 +141,7 @@ impl Scene {
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string_pretty(&SavedScene {
             format: SAVE_FORMAT,
-            scene: self,
+            scene: SceneFile::of(self),
         })
         .map_err(|e| invalid!("cannot serialise the scene: {e}"))
     }
@@ -49,7 +151,7 @@ impl Scene {
         #[derive(Deserialize)]
         struct Loaded {
             format: u32,
-            scene: Scene,
+            scene: SceneFile,
         }
         let loaded: Loaded =
             serde_json::from_str(text).map_err(|e| invalid!("not a swimlab scene file: {e}"))?;
@@ -59,7 +161,7 @@ impl Scene {
                 loaded.format
             ));
         }
-        let s = loaded.scene;
+        let (s, periodic, wall) = loaded.scene.into_parts();
         let n = s.swimmers.len();
         if s.base.len() != n || s.state.len() != STATE_PER_SWIMMER * n {
             return Err(invalid!(
@@ -68,13 +170,13 @@ impl Scene {
                 s.state.len()
             ));
         }
-        s.validate()?;
-        Ok(s)
+        s.validate(periodic, wall)
     }
 
-    /// Check a scene read from a file as the setters check their values: a file that was edited
-    /// by hand, truncated or written by something else is refused with the value at fault.
-    pub(super) fn validate(&self) -> Result<()> {
+    /// Check a scene read from a file, in open space, as the setters check their values, and put
+    /// it in the boundary the file gives (`periodic`, `wall`): a file that was edited by hand,
+    /// truncated or written by something else is refused with the value at fault.
+    fn validate(mut self, periodic: Option<PeriodicBox>, wall: Option<Wall>) -> Result<Scene> {
         require_positive("mu", self.mu, "Pa s")?;
         if let Some(spec) = self.integrator {
             spec.checked()?;
@@ -84,23 +186,17 @@ impl Scene {
         }
         self.thermal.validate()?;
         crate::engine::ewald::check_tol(self.ewald_tol)?;
-        if let Some(b) = self.periodic {
+        if let Some(b) = periodic {
             let mut probe = Scene::new();
             probe.set_box(Some(b.sides()))?;
             for (i, d) in self.swimmers.iter().enumerate() {
-                super::check_fits_box(d, &b).map_err(|e| invalid!("swimmer {i}: {e}"))?;
+                b.check_fits(d).map_err(|e| invalid!("swimmer {i}: {e}"))?;
             }
         }
-        if let Some(w) = self.wall {
-            let w = w.checked()?;
-            if self.periodic.is_some() {
-                return Err(invalid!(
-                    "the scene file has both a wall and a periodic box, which cannot go together; remove one"
-                ));
-            }
-            self.check_wall_reach(&w)?;
-            self.check_above(&w)?;
-        }
+        let wall = wall.map(Wall::checked).transpose()?;
+        self.boundary = Boundary::from_saved(periodic, wall)?;
+        self.check_boundary_reach()?;
+        self.check_clear_of(self.geometry())?;
         crate::engine::forces::ExternalForces::check_force(self.external.force)?;
         if let Some(g) = self.external.gravity {
             g.checked()?;
@@ -141,39 +237,24 @@ impl Scene {
             super::check_center(&self.center(i)?, &self.swimmers)
                 .map_err(|e| invalid!("swimmer {i}: {e}"))?;
         }
-        if let Some(b) = &self.periodic {
-            super::check_box_extent(b, &self.swimmers)?;
+        if let Some(extent) = Extent::of(&self.swimmers) {
+            self.geometry().check_cell(&extent)?;
         }
+        let model = self.swimmer_model();
         for i in 0..self.count() {
-            let v = vec3(&self.state, STATE_PER_SWIMMER * i + 3);
-            let len = v.norm();
-            match self.model {
-                Model::Micro if len <= 0.0 => {
-                    return Err(invalid!(
-                        "swimmer {i}: its dumbbell vector X2 - X1 is zero; a dumbbell needs two distinct spheres"
-                    ))
-                }
-                Model::Averaged | Model::Rigid if (len - 1.0).abs() > 1e-9 => {
-                    return Err(invalid!(
-                        "swimmer {i}: its orientation N has length {len}, not 1; in the {} model the state holds the unit vector N",
-                        self.model.name()
-                    ))
-                }
-                _ => {}
-            }
+            model.check_vector(i, &vec3(&self.state, STATE_PER_SWIMMER * i + 3))?;
         }
         if let Some((gap, a, b)) = self.closest_spheres() {
-            let same = a / 2 == b / 2;
+            let (sa, sb) = (self.owner(a), self.owner(b));
+            let same = sa == sb;
             if gap <= 0.0 && (same || !self.contacts.allow_overlap) {
                 return Err(invalid!(
-                    "spheres {a} and {b} (swimmers {} and {}) overlap by {:.3e} m; move them apart{}",
-                    a / 2,
-                    b / 2,
+                    "spheres {a} and {b} (swimmers {sa} and {sb}) overlap by {:.3e} m; move them apart{}",
                     -gap,
                     if same { "" } else { ", or allow overlaps (\"overlaps\": allow)" }
                 ));
             }
         }
-        Ok(())
+        Ok(self)
     }
 }

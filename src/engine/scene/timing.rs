@@ -1,29 +1,14 @@
 //! The strokes' periods (one, common, shortest), the stiffest spring's rate, and the integrator a
-//! scene takes: the one set, or the model's default for these swimmers.
+//! scene takes: the one set, or the model's default for these swimmers (each model's, by the
+//! integrator policy's constants, re-exported here).
 
 use super::*;
+pub use crate::engine::integrators::{
+    DEFAULT_AUTO_TOL, DEFAULT_AVERAGED_RTOL, DEFAULT_MICRO_MAX_STEP_PER_PERIOD,
+    DEFAULT_MICRO_STEP_TIMES_RATE, DEFAULT_NOISY_STEP_TIMES_RATE, DEFAULT_RIGID_RTOL,
+    DEFAULT_SUSPENSION_TOL,
+};
 
-/// The microscopic model's default RK4 step times the stiffest spring's relaxation rate. RK4 is
-/// stable up to 2.785; at 0.8 the stroke-induced wobble of an isolated asymmetric dumbbell's R_H
-/// closes to far below the Fig-1 drift each period, where a step near the stability bound would
-/// leave a visible share of it (the measurement is in the book's design notes). The error falls
-/// as dt⁵ (the book, "Integrators and accuracy").
-pub const DEFAULT_MICRO_STEP_TIMES_RATE: f64 = 0.8;
-/// With thermal noise the spring model's default Euler-Maruyama step times the stiffest spring's
-/// relaxation rate: Euler-Maruyama overestimates a spring's length variance kT/k0 by 1/(1 − 0.05).
-pub const DEFAULT_NOISY_STEP_TIMES_RATE: f64 = 0.1;
-/// The default step never exceeds this fraction of the shortest period, so that soft springs
-/// (small k0) still resolve the stroke.
-pub const DEFAULT_MICRO_MAX_STEP_PER_PERIOD: f64 = 1.0 / 200.0;
-/// Default tolerance of the rigid-stroke model's adaptive integrator (the book, "Integrators and accuracy").
-pub const DEFAULT_RIGID_RTOL: f64 = 1e-7;
-/// The tolerance of `auto(tol)`, the default of the spring and rigid-stroke models without noise,
-/// relative to the drift: ten times [`dynamics::RK4_DEFAULT_DRIFT_ERROR`], so that auto's inner RK4,
-/// which steps where its drift error is a tenth of tol, steps at exactly the direct step
-/// 0.8/rate. Runs that cannot be averaged are then the direct RK4 runs bit for bit; a larger
-/// inner step errs on the drift of pairs far apart (a swimmer's own stroke error does not shrink
-/// with the interaction; the book, "Long runs").
-pub const DEFAULT_AUTO_TOL: f64 = 1.1e-5;
 /// The largest denominator q of a ratio ωᵢ/ω₀ = p/q that [`Scene::common_period`] recognises.
 pub const MAX_PERIOD_DENOMINATOR: u64 = 64;
 /// The longest common period [`Scene::common_period`] accepts, in periods of the slowest stroke.
@@ -40,14 +25,6 @@ fn gcd(a: u64, b: u64) -> u64 {
 fn lcm(a: u64, b: u64) -> u64 {
     a / gcd(a, b) * b
 }
-
-/// Default tolerance of the averaged model's adaptive integrator.
-pub const DEFAULT_AVERAGED_RTOL: f64 = 1e-8;
-
-/// Default tolerance of `suspension(tol)`, the averaged model's default for a suspension: the
-/// loosest decade whose displacements stay well within 1e-3 (RMS, relative) of fine RK4 on a
-/// suspension with steric contacts (the book, "Suspensions, boxes and fields").
-pub const DEFAULT_SUSPENSION_TOL: f64 = 1e-3;
 
 /// From this many swimmers an averaged scene counts as a suspension (whatever its settings).
 pub const SUSPENSION_SWIMMERS: usize = 64;
@@ -68,69 +45,33 @@ impl Scene {
     /// [`DEFAULT_SUSPENSION_TOL`], else dopri5, whose steps grow to a good fraction of a period
     /// (the averaged model is not stiff).
     pub fn default_integrator(&self) -> IntegratorSpec {
+        let model = self.swimmer_model();
         if self.thermal.is_on() {
-            return self.default_noisy_integrator();
+            return model.default_noisy_integrator(self);
         }
-        match self.model {
-            Model::Micro if self.backend == Backend::Gpu => IntegratorSpec::Rk4 {
-                dt: self.default_micro_step(),
-            },
-            Model::Micro | Model::Rigid => IntegratorSpec::Auto {
-                tol: DEFAULT_AUTO_TOL,
-            },
-            Model::Averaged if self.is_suspension() => IntegratorSpec::Suspension {
-                tol: DEFAULT_SUSPENSION_TOL,
-            },
-            Model::Averaged => IntegratorSpec::Dopri5 {
-                rtol: DEFAULT_AVERAGED_RTOL,
-            },
-        }
+        model.default_integrator(self)
     }
 
     /// Whether the scene is a suspension of the averaged model: a periodic box, a cutoff, steric
     /// repulsion, or at least [`SUSPENSION_SWIMMERS`] swimmers. Its default is then
     /// `suspension(tol)`, whose error is each swimmer's own, where a pair's is the drift's.
     pub fn is_suspension(&self) -> bool {
-        self.model == Model::Averaged
-            && (self.periodic.is_some()
-                || self.cutoff.is_some()
-                || self.contacts.steric.is_some()
-                || self.count() >= SUSPENSION_SWIMMERS)
+        self.swimmer_model().stroke_averaged() && self.crowded()
     }
 
-    /// The default with thermal noise: Euler-Maruyama. The spring model steps at
-    /// [`DEFAULT_NOISY_STEP_TIMES_RATE`]/rate (a spring's stationary variance comes out high by the
-    /// factor 1/(1 − rate·dt/2), 5%), at most 1/200 of the shortest period; the averaged model,
-    /// which has no stroke inside a period, at 1/20 of the period. The rigid-stroke model keeps its
-    /// default and refuses noise when it runs.
-    fn default_noisy_integrator(&self) -> IntegratorSpec {
-        let t_min = self.shortest_period();
-        let dt = match self.model {
-            Model::Micro => (DEFAULT_NOISY_STEP_TIMES_RATE / self.stiff_rate())
-                .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min),
-            Model::Averaged => t_min / 20.0,
-            Model::Rigid => {
-                return IntegratorSpec::Dopri5 {
-                    rtol: DEFAULT_RIGID_RTOL,
-                }
-            }
-        };
-        IntegratorSpec::Euler {
-            dt: if dt.is_finite() { dt } else { 1e-6 },
-        }
+    /// Whether the scene is crowded: a periodic box, a cutoff, steric repulsion, or at least
+    /// [`SUSPENSION_SWIMMERS`] swimmers.
+    pub(super) fn crowded(&self) -> bool {
+        self.periodic().is_some()
+            || self.cutoff.is_some()
+            || self.contacts.steric.is_some()
+            || self.count() >= SUSPENSION_SWIMMERS
     }
 
     /// The microscopic model's default RK4 step for these swimmers (s): 0.8/rate of the stiffest
     /// spring, at most 1/200 of the shortest period.
     pub fn default_micro_step(&self) -> f64 {
-        let t_min = self.shortest_period();
-        let dt = (DEFAULT_MICRO_STEP_TIMES_RATE / self.stiff_rate())
-            .min(DEFAULT_MICRO_MAX_STEP_PER_PERIOD * t_min);
-        if dt.is_finite() {
-            dt
-        } else {
-            1e-6
-        }
+        self.facts().rk4_step()
     }
 
     /// Whether the integrator is the model's default.

@@ -10,7 +10,7 @@
 
 use super::rpb;
 use super::Wall;
-use crate::engine::mobility::{self_mobility, Mobility, MobilityOperator};
+use crate::engine::mobility::{block_matrix, self_mobility, Blocks, Mobility, MobilityOperator};
 use crate::engine::open_space::OpenSpace;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
@@ -228,19 +228,9 @@ impl MobilityOperator for WallMobility {
     }
 
     fn matrix(&self, pos: &[Vector3<f64>], radii: &[f64]) -> DMatrix<f64> {
-        let n = pos.len();
-        let mut m = DMatrix::zeros(3 * n, 3 * n);
-        for a in 0..n {
-            for b in a..n {
-                let h = self.damped_block(&pos[a], &pos[b], radii[a], radii[b], a == b);
-                m.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&h);
-                if a != b {
-                    m.fixed_view_mut::<3, 3>(3 * b, 3 * a)
-                        .copy_from(&h.transpose());
-                }
-            }
-        }
-        m
+        block_matrix(pos.len(), Blocks::Upper, |a, b| {
+            self.damped_block(&pos[a], &pos[b], radii[a], radii[b], a == b)
+        })
     }
 
     /// (∇·M)_α = Σ_β Σ_b ∂M_αβ[·, b]/∂x_β,b by central differences of the closed-form blocks:
@@ -280,24 +270,6 @@ impl MobilityOperator for WallMobility {
             }
             out[a] = div;
         }
-        true
-    }
-
-    fn solid(&self) -> bool {
-        true
-    }
-
-    fn boundary_gap(&self, pos: &[Vector3<f64>], radii: &[f64]) -> Option<(usize, f64)> {
-        self.wall.closest(pos, radii)
-    }
-
-    fn add_boundary_forces(
-        &self,
-        pos: &[Vector3<f64>],
-        radii: &[f64],
-        forces: &mut [Vector3<f64>],
-    ) -> bool {
-        self.wall.add_forces(pos, radii, forces);
         true
     }
 
