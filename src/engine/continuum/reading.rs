@@ -206,8 +206,8 @@ impl Continuum {
     }
 }
 
-/// The Fourier amplitude Σ_σ e^{−ik·R_σ} w_σ of the particles' `kind` (w = 1, N_σ, or
-/// (3N_σN_σ − I)/2 row by row) at box mode `mode` of `scene`'s box, over the swimmers of phase
+/// The Fourier amplitude Σ_σ e^{−ik·R_σ} w(N_σ) of the particles' `kind` (the weight
+/// [`FieldKind::weight`]) at box mode `mode` of `scene`'s box, over the swimmers of phase
 /// `phase` (all when `None`): the particles' side of [`Continuum::mode`].
 pub fn particle_mode(
     scene: &Scene,
@@ -262,17 +262,8 @@ pub fn particle_mode(
             .map(|a| -2.0 * PI * mode[a] as f64 * r[a] / sides[a])
             .sum();
         let e = Complex64::from_polar(1.0, arg);
-        match kind {
-            FieldKind::Density => out[0] += e,
-            FieldKind::Polarization => (0..3).for_each(|a| out[a] += e * n[a]),
-            FieldKind::Nematic => {
-                for a in 0..3 {
-                    for c in 0..3 {
-                        let q = 1.5 * n[a] * n[c] - if a == c { 0.5 } else { 0.0 };
-                        out[3 * a + c] += e * q;
-                    }
-                }
-            }
+        for (o, w) in out.iter_mut().zip(kind.weight(n)) {
+            *o += e * w;
         }
     }
     Ok(out)

@@ -25,6 +25,7 @@
 use super::choice::{self, Choice, Named};
 use super::error::{invalid, unsupported, Result, Setting};
 use super::mobility::{self_mobility, Mobility, MobilityOperator};
+use super::parallel::PARALLEL_IMAGE_SPHERES;
 use super::periodic::{PeriodicBox, WavePhases};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
@@ -88,9 +89,6 @@ impl EwaldMethod {
 
 /// The default tolerance of the Ewald sums (relative to the spheres' Stokes mobility).
 pub const DEFAULT_EWALD_TOL: f64 = 1e-10;
-
-/// From this many spheres the sums run in parallel.
-const PARALLEL_SPHERES: usize = 64;
 
 /// One reciprocal vector of the half space (its partner −k adds the same real part).
 #[derive(Debug, Clone, Copy)]
@@ -423,7 +421,7 @@ impl Ewald {
         }
         let n = pos.len();
         let unit = 1.0 / (6.0 * PI * self.split.mu);
-        let parallel = n >= PARALLEL_SPHERES;
+        let parallel = n >= PARALLEL_IMAGE_SPHERES;
         // Reciprocal space: per wave, C = Σ_j F_j e^{−ik·x_j} and D = Σ_j a_j² F_j e^{−ik·x_j}.
         let phases = WavePhases::new(&self.periodic, pos, self.n_max);
         let sums = |w: &Wave| {
