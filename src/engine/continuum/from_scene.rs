@@ -9,6 +9,7 @@ use crate::engine::averaged::pair_constants;
 use crate::engine::error::{invalid, Result};
 use crate::engine::integrators::{Dopri5, Stats};
 use crate::engine::scene::Scene;
+use crate::engine::stepping::RunControl;
 use crate::engine::thermal::RigidDiffusion;
 use rustfft::num_complex::Complex64;
 use std::sync::Arc;
@@ -107,7 +108,7 @@ impl Continuum {
             period: first.period(),
             tol: spec.tol,
             kind: first,
-            interrupt: None,
+            control: RunControl::default(),
         };
         c.filter_state();
         Ok(c)

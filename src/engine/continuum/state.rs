@@ -5,6 +5,7 @@ use super::operator::Kinetic;
 use super::spec::Population;
 use crate::engine::error::{invalid, Result};
 use crate::engine::integrators::{Dopri5, Stats};
+use crate::engine::stepping::RunControl;
 use crate::engine::swimmer::Dumbbell;
 use std::f64::consts::PI;
 
@@ -27,7 +28,8 @@ pub struct Continuum {
     pub(super) tol: f64,
     /// The swimmer kind (phase aside).
     pub(super) kind: Dumbbell,
-    pub(super) interrupt: Option<crate::engine::integrators::Interrupt>,
+    /// What every run takes: the interrupt and the progress report (a scene's run control).
+    pub(super) control: RunControl,
 }
 
 impl std::fmt::Debug for Continuum {
