@@ -1,6 +1,6 @@
 //! Open space, the unbounded fluid: the RPY (or Oseen) pair tensor summed over all pairs, as a
 //! [`MobilityOperator`]. Small sets take the symmetric half-loop of [`Mobility`], large ones the
-//! vectorised row kernel of [`super::pairs`], on rayon's threads from [`PARALLEL_SPHERES`] on.
+//! vectorised row kernel of [`super::pairs`], on rayon's threads from `PARALLEL_SPHERES` on.
 
 use super::mobility::{self_mobility, Mobility, MobilityOperator};
 use super::pairs::{self, SoaSpheres};

@@ -314,7 +314,7 @@ fn character(
 
 impl Continuum {
     /// Growth rates about a homogeneous state at wave vector `k` (1/m), fastest first: the
-    /// eigenvalues of the linearised operator (see [`growth_rates`]).
+    /// eigenvalues of the linearised operator ([`Continuum::linear_operator`]).
     pub fn growth_rates(&self, base: &BaseState, k: [f64; 3]) -> Result<Vec<Mode>> {
         let mean = self.mean_densities();
         growth_rates(&self.kinetic.op, &self.populations, &mean, base, k)
