@@ -663,3 +663,56 @@ fn thermal_modes_decay_at_the_dumbbells_diffusion_rates() {
     let want = (modes[0].rate * t).exp();
     assert!(((a1 / a0).re - want).abs() <= 1e-6, "{} vs {want}", a1 / a0);
 }
+
+/// A continuum's runs take a scene's run control: the progress is told the time after every
+/// step, rising to the run's end; an interrupt stops a run between steps with `Interrupted` at
+/// the last step's time, keeping what that step left, and the next run goes on from there.
+#[test]
+fn continuum_runs_report_progress_and_stop_on_an_interrupt() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{Arc, Mutex};
+    use swimlab::engine::EngineError;
+    let side = 20.0 * asymmetric().ell;
+    let s = two_populations(100, side, 11);
+    let spec = ContinuumSpec {
+        grid: [8, 8, 8],
+        width: Some(2.0 * asymmetric().ell),
+        ..Default::default()
+    };
+    let mut c = Continuum::of(&s, &spec).unwrap();
+    let times = Arc::new(Mutex::new(Vec::new()));
+    let told = times.clone();
+    c.set_progress(Some(Arc::new(move |t| told.lock().unwrap().push(t))));
+    let end = c.time() + 20.0 * c.period();
+    c.run_periods(20.0).unwrap();
+    let seen = std::mem::take(&mut *times.lock().unwrap());
+    assert!(!seen.is_empty());
+    assert!(seen.windows(2).all(|w| w[0] < w[1]), "{seen:?}");
+    assert_eq!(*seen.last().unwrap(), c.time());
+    assert!(
+        (c.time() - end).abs() <= 1e-12 * end,
+        "{} of {end}",
+        c.time()
+    );
+
+    // The interrupt is asked before every step: the fourth question stops the run (a run of 1e6
+    // periods takes more than three steps: each step grows the last one by a bounded factor).
+    let asked = Arc::new(AtomicUsize::new(0));
+    let count = asked.clone();
+    c.set_interrupt(Some(Arc::new(move || {
+        count.fetch_add(1, Ordering::SeqCst) >= 3
+    })));
+    let start = c.time();
+    match c.run_periods(1e6) {
+        Err(EngineError::Interrupted { time }) => assert_eq!(time, c.time()),
+        other => panic!("not interrupted: {other:?}"),
+    }
+    let seen = std::mem::take(&mut *times.lock().unwrap());
+    assert_eq!(seen.len(), 3, "{seen:?}");
+    assert_eq!(*seen.last().unwrap(), c.time());
+    assert!(c.time() > start);
+    let stopped = c.time();
+    c.set_interrupt(None);
+    c.run_periods(1.0).unwrap();
+    assert!(c.time() > stopped);
+}

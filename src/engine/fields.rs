@@ -59,6 +59,24 @@ impl FieldKind {
             FieldKind::Nematic => 9,
         }
     }
+
+    /// What one swimmer of orientation `n` carries into this field, w(N): 1, N, or (3NN − I)/2
+    /// row by row, in the first [`FieldKind::components`] entries.
+    pub fn weight(self, n: Vector3<f64>) -> [f64; 9] {
+        let mut w = [0.0; 9];
+        match self {
+            FieldKind::Density => w[0] = 1.0,
+            FieldKind::Polarization => w[..3].copy_from_slice(n.as_slice()),
+            FieldKind::Nematic => {
+                for a in 0..3 {
+                    for c in 0..3 {
+                        w[3 * a + c] = 1.5 * n[a] * n[c] - if a == c { 0.5 } else { 0.0 };
+                    }
+                }
+            }
+        }
+        w
+    }
 }
 
 /// The most cells a field may have (64 MB of f64 for a nematic field).
@@ -250,14 +268,7 @@ impl Field {
             let total: f64 = gx.iter().map(|g| g.1).sum::<f64>()
                 * gy.iter().map(|g| g.1).sum::<f64>()
                 * gz.iter().map(|g| g.1).sum::<f64>();
-            let terms: Vec<f64> = match self.kind {
-                FieldKind::Density => vec![],
-                FieldKind::Polarization => vec![dir.x, dir.y, dir.z],
-                FieldKind::Nematic => {
-                    let q: Matrix3<f64> = 1.5 * dir * dir.transpose() - 0.5 * Matrix3::identity();
-                    q.transpose().iter().copied().collect()
-                }
-            };
+            let terms = self.kind.weight(*dir);
             for &(k, fz) in &gz {
                 for &(j, fy) in &gy {
                     for &(i, fx) in &gx {

@@ -32,6 +32,7 @@ pub mod neighbours;
 pub mod observable;
 pub mod open_space;
 pub mod pairs;
+mod parallel;
 pub mod periodic;
 pub mod plan;
 pub mod recorder;

@@ -1,18 +1,16 @@
 //! Open space, the unbounded fluid: the RPY (or Oseen) pair tensor summed over all pairs, as a
 //! [`MobilityOperator`]. Small sets take the symmetric half-loop of [`Mobility`], large ones the
-//! vectorised row kernel of [`super::pairs`], on rayon's threads from [`PARALLEL_SPHERES`] on.
+//! vectorised row kernel of [`super::pairs`], on rayon's threads from `PARALLEL_SPHERES` on.
 
 use super::mobility::{self_mobility, Mobility, MobilityOperator};
 use super::pairs::{self, SoaSpheres};
+use super::parallel::PARALLEL_SPHERES;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// From this many spheres on, the vectorised row kernel ([`pairs`]) replaces the symmetric
 /// half-loop (below this size the half-loop's halved arithmetic wins; the measurement is in the
 /// book's design notes).
 pub const FAST_KERNEL_SPHERES: usize = 64;
-/// From this many spheres on, the rows run in parallel: a product is then long enough that
-/// rayon's dispatch is a negligible share of it (timings in the book's design notes).
-pub const PARALLEL_SPHERES: usize = 256;
 
 /// The mobility of spheres in an unbounded fluid of viscosity `mu`.
 #[derive(Debug, Clone)]

@@ -6,8 +6,9 @@ use super::boundary::Boundary;
 use super::contacts::Contacts;
 use super::integrators::Problem;
 use super::mobility::{self_mobility, Mobility, MobilityOperator};
-use super::open_space::{OpenSpace, FAST_KERNEL_SPHERES, PARALLEL_SPHERES};
+use super::open_space::{OpenSpace, FAST_KERNEL_SPHERES};
 use super::pairs::SoaSpheres;
+use super::parallel::PARALLEL_SPHERES;
 use super::swimmer::Dumbbell;
 use nalgebra::Vector3;
 

@@ -1,7 +1,8 @@
 //! Heat maps: a 2D array of values as coloured cells (a field's slice), with a colour bar.
 
+use super::image::{Format, Image};
 use super::render::{err, in_memory, register_font, to_file, Drawable};
-use super::{Format, Image};
+use super::ticks::format_number;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -108,7 +109,7 @@ impl HeatMap {
         let mut chart = builder
             .build_cartesian_2d(x.0..x.1, y.0..y.1)
             .map_err(err)?;
-        let fmt = |v: &f64| super::format_number(*v, (x.1 - x.0).max(y.1 - y.0));
+        let fmt = |v: &f64| format_number(*v, (x.1 - x.0).max(y.1 - y.0));
         chart
             .configure_mesh()
             .disable_mesh()
@@ -156,7 +157,7 @@ impl HeatMap {
             )
         }))
         .map_err(err)?;
-        let vfmt = |v: &f64| super::format_number(*v, span);
+        let vfmt = |v: &f64| format_number(*v, span);
         c.configure_secondary_axes()
             .y_desc(self.value_desc.as_str())
             .y_label_formatter(&vfmt)

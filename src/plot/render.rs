@@ -1,6 +1,8 @@
 //! Drawing with plotters: figures and scene pictures to SVG or PNG.
 
-use super::{Figure, Format, Legend, Style, COLORS};
+use super::figure::{Figure, Legend, Series, Style, COLORS};
+use super::image::{Format, Image};
+use super::ticks::format_number;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -23,6 +25,22 @@ pub(super) fn register_font() {
 /// [`crate::engine::files`]), so this is plotters' own text.
 pub(super) fn err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
     format!("cannot draw the picture: {e}")
+}
+
+impl Figure {
+    /// Draw in memory, as PNG and SVG.
+    pub fn image(&self) -> Result<Image, String> {
+        self.validate()?;
+        in_memory((self.width, self.height), self)
+    }
+
+    /// Draw to `path` (SVG or PNG by its extension); folders are created.
+    pub fn save(&self, path: &std::path::Path) -> Result<(), String> {
+        self.validate()?;
+        let format = Format::of(path)?;
+        crate::engine::files::ensure_parent(path).map_err(|e| e.to_string())?;
+        figure(self, path, format)
+    }
 }
 
 /// Draw `f` to `path` in `format`.
@@ -65,7 +83,7 @@ pub(super) fn to_file(
 
 /// A picture drawn in memory by `draw` onto an SVG and a bitmap of `size`: the SVG text and the
 /// PNG bytes.
-pub(super) fn in_memory(size: (u32, u32), picture: &dyn Drawable) -> Result<super::Image, String> {
+pub(super) fn in_memory(size: (u32, u32), picture: &dyn Drawable) -> Result<Image, String> {
     register_font();
     let mut svg = String::new();
     {
@@ -79,7 +97,7 @@ pub(super) fn in_memory(size: (u32, u32), picture: &dyn Drawable) -> Result<supe
         picture.draw_bitmap(&root)?;
         root.present().map_err(err)?;
     }
-    Ok(super::Image {
+    Ok(Image {
         png: encode_png(&rgb, size)?,
         svg,
         width: size.0,
@@ -129,9 +147,9 @@ fn encode_png(rgb: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, String> {
     Ok(out)
 }
 
-/// A tick label with as many digits as the axis span needs ([`super::format_number`]).
+/// A tick label with as many digits as the axis span needs ([`format_number`]).
 fn tick(v: f64, span: f64) -> String {
-    super::format_number(v, span)
+    format_number(v, span)
 }
 
 /// The span a tick at `v` is judged against: the axis range, or on a log axis the value itself
@@ -150,7 +168,7 @@ fn color(k: usize) -> RGBColor {
 }
 
 /// The labels of a figure's legend, with each entry's series.
-fn legend_entries(f: &Figure) -> Vec<(usize, &super::Series)> {
+fn legend_entries(f: &Figure) -> Vec<(usize, &Series)> {
     f.series
         .iter()
         .enumerate()

@@ -3,8 +3,8 @@
 //! aligned swimmers share a colour, so order is visible at a glance). Nearer swimmers (larger
 //! third coordinate) are drawn over farther ones.
 
+use super::image::{Format, Image};
 use super::render::{self, Disc, ScenePicture};
-use super::Format;
 use crate::engine::boundary::MAX_EXTENT_IN_RADII;
 use crate::engine::Scene;
 use plotters::style::{Color, HSLColor, RGBColor};
@@ -83,7 +83,7 @@ pub fn snapshot(scene: &Scene, opts: &SnapshotOptions, path: &Path) -> Result<()
 }
 
 /// A picture of `scene` drawn in memory (PNG and SVG), as [`snapshot`] draws it to a file.
-pub fn scene_image(scene: &Scene, opts: &SnapshotOptions) -> Result<super::Image, String> {
+pub fn scene_image(scene: &Scene, opts: &SnapshotOptions) -> Result<Image, String> {
     let picture = picture(scene, opts)?;
     render::in_memory(picture.size, &picture)
 }

@@ -1,7 +1,8 @@
 //! Quick plots as text for the terminal: each series drawn with its own character on a grid of
 //! `cols` × `rows` cells, consecutive points of a line joined, with the ranges and a legend.
 
-use super::{Figure, Style};
+use super::figure::{Figure, Style};
+use super::ticks::format_number;
 
 /// Markers of the series, in turn.
 const MARKS: [char; 6] = ['*', 'o', '+', 'x', '#', '@'];
@@ -50,9 +51,9 @@ pub fn render_text(f: &Figure, cols: usize, rows: usize) -> Result<String, Strin
     }
     let label = |v: f64, log: bool, span: f64| {
         if log {
-            super::format_number(10f64.powf(v), 10.0 * 10f64.powf(v))
+            format_number(10f64.powf(v), 10.0 * 10f64.powf(v))
         } else {
-            super::format_number(v, span)
+            format_number(v, span)
         }
     };
     let mut out = String::new();

@@ -136,10 +136,15 @@ fn build(s: &SceneHandle, opts: &Map) -> ScriptResult<ContinuumHandle> {
     Ok(ContinuumHandle::new(c))
 }
 
+/// Run `c` for `seconds` as a scene runs: stopped by Ctrl-C (or a kernel's interrupt) at a step
+/// boundary, with the same progress bar.
 fn run(c: &ContinuumHandle, seconds: f64) -> ScriptResult<()> {
     let mut g = c.lock_mut()?;
     g.set_interrupt(Some(Arc::new(super::interrupt::requested)));
-    let r = g.run(seconds);
+    let (t0, period) = (g.time(), Some(g.period()));
+    let r = super::progress::with_bar(&mut *g, t0, seconds, period, Continuum::set_progress, |c| {
+        c.run(seconds)
+    });
     g.set_interrupt(None);
     lift(r)
 }

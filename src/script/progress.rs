@@ -116,6 +116,29 @@ impl RunBar {
     }
 }
 
+/// Run `f` on `target` (a scene or a continuum) with a bar over its next `duration` seconds from
+/// `t0`, counted in periods of `period` when given: `set` hands the bar's report to the target
+/// before the run and takes it back after (nothing where bars are not drawn).
+pub(super) fn with_bar<S, T>(
+    target: &mut S,
+    t0: f64,
+    duration: f64,
+    period: Option<f64>,
+    set: impl Fn(&mut S, Option<Progress>),
+    f: impl FnOnce(&mut S) -> T,
+) -> T {
+    match RunBar::start(t0, t0 + duration, period) {
+        Some((bar, report)) => {
+            set(target, Some(report));
+            let r = f(target);
+            set(target, None);
+            drop(bar);
+            r
+        }
+        None => f(target),
+    }
+}
+
 impl Drop for RunBar {
     fn drop(&mut self) {
         if let Some((sink, last)) = &self.sink {

@@ -308,17 +308,8 @@ fn with_bar<T>(
     duration: f64,
     f: impl FnOnce(&mut Simulation) -> crate::engine::Result<T>,
 ) -> crate::engine::Result<T> {
-    let t0 = sc.time();
-    match super::progress::RunBar::start(t0, t0 + duration, sc.period().ok()) {
-        Some((bar, report)) => {
-            sc.set_progress(Some(report));
-            let r = f(sc);
-            sc.set_progress(None);
-            drop(bar);
-            r
-        }
-        None => f(sc),
-    }
+    let (t0, period) = (sc.time(), sc.period().ok());
+    super::progress::with_bar(sc, t0, duration, period, Simulation::set_progress, f)
 }
 
 /// Register the `Scene` type and its methods and properties.

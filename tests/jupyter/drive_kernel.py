@@ -137,6 +137,33 @@ try:
     kinds = [m["msg_type"] for m in out]
     check("a long run shows progress updating in place", "display_data" in kinds and "update_display_data" in kinds, kinds)
 
+    # A continuum runs as a scene does: its long run shows the progress line and an interrupt
+    # stops it at a step boundary, the continuum kept and moved on (a step of this one takes
+    # about a second, so the line is shown after the first and the run is far from its end).
+    run(kc, 'let cs = scene(); cs.model = "averaged"; cs.box = [400e-6, 400e-6, 400e-6]; '
+            'cs.add_random(dumbbell(), 40, 1, #{ phase: 0.0 }); '
+            'cs.add_random(dumbbell(), 40, 2, #{ phase: pi() / 2.0 }); '
+            'let c = continuum(cs, #{ grid: 16, orientations: 4 }); c.perturb(#{ amplitude: 0.5 });')
+    before = of_type(run(kc, "c.time")[1], "execute_result")[0]["data"]["text/plain"]
+    msg_id = kc.execute("c.run_periods(1e6)")
+    time.sleep(3.0)
+    m = kc.session.msg("interrupt_request", {})
+    kc.control_channel.send(m)
+    kc.control_channel.get_msg(timeout=TIMEOUT)
+    reply = kc.get_shell_msg(timeout=TIMEOUT)
+    check("an interrupt stops a continuum's run", reply["parent_header"]["msg_id"] == msg_id and reply["content"]["status"] == "error" and "interrupt" in reply["content"]["evalue"].lower(), reply["content"])
+    kinds = []
+    while True:
+        m = kc.get_iopub_msg(timeout=TIMEOUT)
+        if m["parent_header"].get("msg_id") != msg_id:
+            continue
+        if m["msg_type"] == "status" and m["content"]["execution_state"] == "idle":
+            break
+        kinds.append(m["msg_type"])
+    check("a continuum's long run shows progress updating in place", "display_data" in kinds and "update_display_data" in kinds, kinds)
+    after = of_type(run(kc, "c.time")[1], "execute_result")[0]["data"]["text/plain"]
+    check("the continuum is kept and moved on", float(after) > float(before), (before, after))
+
     c = kc.complete("s.run_per", 9, reply=True, timeout=TIMEOUT)["content"]
     check("completion", "run_periods" in c["matches"] and c["cursor_start"] == 2 and c["cursor_end"] == 9, c)
     c = kc.complete("twi", 3, reply=True, timeout=TIMEOUT)["content"]

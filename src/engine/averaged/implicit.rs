@@ -9,8 +9,9 @@
 //! distance from the Jacobian, so a block that carried the law on past the range would cost the
 //! swimmers about to touch their steps). The far field stays explicit.
 
-use super::{vec3, AveragedSystem, STATE_PER_SWIMMER};
+use super::system::AveragedSystem;
 use crate::engine::integrators::GroupJacobian;
+use crate::engine::model::{vec3, STATE_PER_SWIMMER};
 use crate::engine::periodic::separation;
 use nalgebra::Vector3;
 use rayon::prelude::*;

@@ -8,7 +8,8 @@
 //! neither the thread count nor the vector width, and equals the scalar row's to the rounding of
 //! another summation order.
 
-use super::{AveragedSystem, Coef, CutoffSwitch, SIN_ZERO};
+use super::system::AveragedSystem;
+use super::terms::{Coef, CutoffSwitch, SIN_ZERO};
 use crate::engine::simd::{lane_sum, vector_dispatch};
 use nalgebra::Vector3;
 

@@ -7,23 +7,11 @@
 //! in a fixed order: a row depends on neither the thread count nor the vector width.
 
 use super::lanes::{side, Acc};
-use super::{AveragedSystem, CutoffSwitch, Soa};
+use super::arrays::{SlotConst, Soa};
+use super::{AveragedSystem, CutoffSwitch};
 use crate::engine::neighbours::NeighbourList;
 use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
 use nalgebra::Vector3;
-
-/// A swimmer's constants, kept by slot so that a pass in slot order reads them in order.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct SlotConst {
-    /// The far rows' prefactors ([`super::lanes::prefactors`]).
-    pub(super) pre: [f64; 4],
-    /// Its length ℓ (m).
-    pub(super) ell: f64,
-    /// Its spheres' weights (w1, w2): the spheres sit at −w2ℓN and +w1ℓN from its centre.
-    pub(super) w: (f64, f64),
-    /// Its sphere radii (m).
-    pub(super) a: [f64; 2],
-}
 
 /// One partner's terms added to the row's accumulators: the row at `at` with orientation `n` and
 /// prefactors `k`, the partner at (x, y, z) with orientation (bx, by, bz) and phase sine `sin`.

@@ -2,7 +2,8 @@
 //! centres move (rebuilt once a centre has moved half the skin), their slot arrays refilled at
 //! every right-hand side, and the steric forces and the contact guard through their near rows.
 
-use super::list_rows::{self, SlotConst};
+use super::arrays::SlotConst;
+use super::list_rows;
 use super::{
     pair_weight, AveragedSystem, Problem, Soa, DEFAULT_SKIN_OF_CUTOFF, LIST_SWIMMERS,
     PARALLEL_SWIMMERS, STATE_PER_SWIMMER,
@@ -15,34 +16,6 @@ use rayon::prelude::*;
 /// Above this share of swimmers leaving their lists at once, the whole list is built anew
 /// instead of relisting them one by one.
 pub const MAX_RELISTED_FRACTION: f64 = 0.1;
-
-/// The list and the arrays in its slot order.
-#[derive(Debug, Clone, Default)]
-pub(super) struct Listed {
-    list: Option<NeighbourList>,
-    /// Positions and orientations by slot (swimmers, ghosts, the pad).
-    slots: Soa,
-    /// Constants by slot (swimmers, ghosts, the pad), for the list built `consts_of`-th.
-    consts: Vec<SlotConst>,
-    consts_of: Option<u64>,
-    /// Scratch: rates by slot.
-    rates: Vec<[f64; 6]>,
-    /// Scratch: steric forces on each slot's two spheres.
-    forces: Vec<[Vector3<f64>; 2]>,
-    builds: u64,
-}
-
-impl Listed {
-    /// Lists built so far.
-    pub(super) fn builds(&self) -> u64 {
-        self.builds
-    }
-
-    /// Swimmers relisted so far (in the list in use).
-    pub(super) fn relists(&self) -> u64 {
-        self.list.as_ref().map_or(0, |l| l.relists)
-    }
-}
 
 impl AveragedSystem {
     /// Whether the cutoff's pairs are summed over neighbour lists.

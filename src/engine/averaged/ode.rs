@@ -1,7 +1,11 @@
 //! The averaged model as an [`OdeSystem`]: its rates, the suspension stepper's stiff groups and
 //! error norm, the guards, thermal noise and the projection onto unit orientations.
 
-use super::*;
+use super::system::{AveragedSystem, LIST_SWIMMERS, PARALLEL_SWIMMERS};
+use crate::engine::integrators::{GroupJacobian, Noise, OdeSystem, Partitioned, Problem};
+use crate::engine::model::{set_vec3, vec3, STATE_PER_SWIMMER};
+use nalgebra::Vector3;
+use rayon::prelude::*;
 
 impl OdeSystem for AveragedSystem {
     fn dim(&self) -> usize {
@@ -141,8 +145,8 @@ impl OdeSystem for AveragedSystem {
         for (i, p) in self.sphere_pos.iter().enumerate() {
             (g.x[i], g.y[i], g.z[i]) = (p.x, p.y, p.z);
         }
-        match super::super::gaps::closest_overlap(g, &self.radii, parallel) {
-            Some((gap, a, b)) => Err(super::super::spheres::overlap_problem(gap, a, b)),
+        match crate::engine::gaps::closest_overlap(g, &self.radii, parallel) {
+            Some((gap, a, b)) => Err(crate::engine::spheres::overlap_problem(gap, a, b)),
             None => Ok(()),
         }
     }

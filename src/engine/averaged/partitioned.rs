@@ -4,8 +4,9 @@
 //! few swimmers cost what their own rows cost: with neighbour lists, only the slot entries of the
 //! swimmers that moved are refreshed.
 
-use super::{vec3, AveragedSystem, STATE_PER_SWIMMER};
+use super::system::AveragedSystem;
 use crate::engine::integrators::{GroupJacobian, Partitioned};
+use crate::engine::model::{vec3, STATE_PER_SWIMMER};
 use crate::engine::neighbours::NeighbourList;
 use crate::engine::periodic::separation;
 use nalgebra::Vector3;

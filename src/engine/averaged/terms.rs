@@ -1,9 +1,11 @@
 //! The averaged model's terms: each swimmer's constants (the I, J, K, L weights and the stroke),
 //! the smooth switch of a far-field cutoff, and the phase weight of a pair.
 
-use super::SIN_ZERO;
 use crate::engine::model::Coefficients;
 use crate::engine::swimmer::Dumbbell;
+
+/// |sin(Δφ)| below this counts as zero: phases given as 0 and π differ by rounding only.
+pub(super) const SIN_ZERO: f64 = 1e-14;
 
 /// Per-swimmer constants of the averaged equations.
 #[derive(Debug, Clone, Copy)]

@@ -2,7 +2,7 @@
 //! state with a plane wave) and particles drawn from its distribution.
 
 use super::stability::BaseState;
-use super::Continuum;
+use super::state::Continuum;
 use crate::engine::build::place_apart;
 use crate::engine::error::{invalid, Result};
 use crate::engine::fields::FieldKind;

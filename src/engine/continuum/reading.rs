@@ -2,7 +2,8 @@
 //! compare with them.
 
 use super::spec::SAME_PHASE;
-use super::Continuum;
+use super::sphere::monomial;
+use super::state::Continuum;
 use crate::engine::error::{invalid, Result};
 use crate::engine::fields::{Field, FieldKind};
 use crate::engine::scene::Scene;
@@ -10,6 +11,33 @@ use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
 
 impl Continuum {
+    /// The mean-field rates (dR_H/dt, dN/dt) of a swimmer of population `p` with orientation `n`
+    /// at every cell centre: the particles' averaged rates summed over the distribution.
+    pub fn mean_field(&self, p: usize, n: [f64; 3]) -> Result<Vec<([f64; 3], [f64; 3])>> {
+        self.check_population(p)?;
+        let op = &self.kinetic.op;
+        let u = op.mean_field_terms(&self.state, self.kinetic.pops, p);
+        let mut out = vec![([0.0; 3], [0.0; 3]); op.cells];
+        if let Some(u) = u {
+            for (g, (o, _, comps)) in op.groups.iter().enumerate() {
+                let m = monomial(&n, &op.comps[comps[0]].alpha);
+                for (cell, r) in out.iter_mut().enumerate() {
+                    if *o < 3 {
+                        r.0[*o] += m * u[g][cell];
+                    } else {
+                        r.1[*o - 3] += m * u[g][cell];
+                    }
+                }
+            }
+            for r in &mut out {
+                let t = r.1;
+                let along = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+                r.1 = std::array::from_fn(|d| -(t[d] - along * n[d]));
+            }
+        }
+        Ok(out)
+    }
+
     /// The field `kind` of population `population` (all populations when `None`), on the grid:
     /// the same [`Field`] as a scene's, with the continuum's smoothing width.
     pub fn field(&self, kind: FieldKind, population: Option<usize>) -> Result<Field> {
@@ -178,8 +206,8 @@ impl Continuum {
     }
 }
 
-/// The Fourier amplitude Σ_σ e^{−ik·R_σ} w_σ of the particles' `kind` (w = 1, N_σ, or
-/// (3N_σN_σ − I)/2 row by row) at box mode `mode` of `scene`'s box, over the swimmers of phase
+/// The Fourier amplitude Σ_σ e^{−ik·R_σ} w(N_σ) of the particles' `kind` (the weight
+/// [`FieldKind::weight`]) at box mode `mode` of `scene`'s box, over the swimmers of phase
 /// `phase` (all when `None`): the particles' side of [`Continuum::mode`].
 pub fn particle_mode(
     scene: &Scene,
@@ -234,17 +262,8 @@ pub fn particle_mode(
             .map(|a| -2.0 * PI * mode[a] as f64 * r[a] / sides[a])
             .sum();
         let e = Complex64::from_polar(1.0, arg);
-        match kind {
-            FieldKind::Density => out[0] += e,
-            FieldKind::Polarization => (0..3).for_each(|a| out[a] += e * n[a]),
-            FieldKind::Nematic => {
-                for a in 0..3 {
-                    for c in 0..3 {
-                        let q = 1.5 * n[a] * n[c] - if a == c { 0.5 } else { 0.0 };
-                        out[3 * a + c] += e * q;
-                    }
-                }
-            }
+        for (o, w) in out.iter_mut().zip(kind.weight(n)) {
+            *o += e * w;
         }
     }
     Ok(out)

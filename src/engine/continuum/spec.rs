@@ -3,7 +3,6 @@
 
 use super::operator::Operator;
 use super::sphere::MAX_DEGREE;
-use super::Population;
 use crate::engine::error::{invalid, short, Result};
 use crate::engine::fields::gaussian_axis;
 use crate::engine::integrators::{check_tolerance, MIN_DRIFT_TOL};
@@ -15,6 +14,15 @@ pub const MAX_CELLS: usize = 1 << 15;
 
 /// The most phase populations a continuum tracks.
 pub const MAX_POPULATIONS: usize = 16;
+
+/// One phase population.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Population {
+    /// Its phase φ (rad, in [0, 2π)).
+    pub phase: f64,
+    /// How many swimmers of the scene it was built from.
+    pub swimmers: usize,
+}
 
 /// Phases closer than this (rad) are one population.
 pub(super) const SAME_PHASE: f64 = 1e-9;

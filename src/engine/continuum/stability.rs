@@ -13,7 +13,8 @@
 
 use super::kernel::{self, Radial};
 use super::operator::Operator;
-use super::Population;
+use super::spec::Population;
+use super::state::Continuum;
 use crate::engine::error::{invalid, Result};
 use nalgebra::DMatrix;
 use rustfft::num_complex::Complex64;
@@ -309,4 +310,29 @@ fn character(
         .map(|(k, _)| *k)
         .unwrap_or((0, 0));
     (best.1, best.0)
+}
+
+impl Continuum {
+    /// Growth rates about a homogeneous state at wave vector `k` (1/m), fastest first: the
+    /// eigenvalues of the linearised operator ([`Continuum::linear_operator`]).
+    pub fn growth_rates(&self, base: &BaseState, k: [f64; 3]) -> Result<Vec<Mode>> {
+        let mean = self.mean_densities();
+        growth_rates(&self.kinetic.op, &self.populations, &mean, base, k)
+    }
+
+    /// The operator linearised about `base` at wave vector `k` (1/m): dδc/dt = A δc, δc_{p,i} the
+    /// complex amplitude of c_{p,i} at e^{ik·x}, at [p·B + i].
+    pub fn linear_operator(
+        &self,
+        base: &BaseState,
+        k: [f64; 3],
+    ) -> Result<nalgebra::DMatrix<Complex64>> {
+        let mean = self.mean_densities();
+        linear_operator(&self.kinetic.op, &self.populations, &mean, base, k)
+    }
+
+    /// The state of a homogeneous `base` at each population's mean density, [p·B + i].
+    pub fn base_coefficients(&self, base: &BaseState) -> Result<Vec<f64>> {
+        base_coefficients(&self.kinetic.op, &self.mean_densities(), base)
+    }
 }

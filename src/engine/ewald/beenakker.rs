@@ -7,13 +7,11 @@ use super::spectral::SpectralEwald;
 use super::split::{truncation, Split};
 use crate::engine::error::{invalid, unsupported, Result, Setting};
 use crate::engine::mobility::{block_matrix, self_mobility, Blocks, Mobility, MobilityOperator};
+use crate::engine::parallel::PARALLEL_IMAGE_SPHERES;
 use crate::engine::periodic::{PeriodicBox, WavePhases};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
-
-/// From this many spheres the sums run in parallel.
-const PARALLEL_SPHERES: usize = 64;
 
 /// One reciprocal vector of the half space (its partner −k adds the same real part).
 #[derive(Debug, Clone, Copy)]
@@ -267,7 +265,7 @@ impl Ewald {
         }
         let n = pos.len();
         let unit = 1.0 / (6.0 * PI * self.split.mu);
-        let parallel = n >= PARALLEL_SPHERES;
+        let parallel = n >= PARALLEL_IMAGE_SPHERES;
         // Reciprocal space: per wave, C = Σ_j F_j e^{−ik·x_j} and D = Σ_j a_j² F_j e^{−ik·x_j}.
         let phases = WavePhases::new(&self.periodic, pos, self.n_max);
         let sums = |w: &Wave| {

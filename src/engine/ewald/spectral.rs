@@ -22,6 +22,7 @@ use super::split::{truncation, Split};
 use crate::engine::cells::CellGrid;
 use crate::engine::error::{invalid, Result};
 use crate::engine::fft3::{signed_mode, Fft3};
+use crate::engine::parallel::PARALLEL_IMAGE_SPHERES;
 use crate::engine::periodic::PeriodicBox;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -31,9 +32,6 @@ use std::f64::consts::PI;
 /// The largest grid (points) the method builds: 3 fields of 2^22 complex points and their
 /// transposes take 400 MB.
 pub const MAX_GRID_POINTS: usize = 1 << 22;
-
-/// From this many spheres the real-space rows run in parallel.
-const PARALLEL_SPHERES: usize = 64;
 
 /// The Gaussian support P (points per axis) for tolerance `tol`: e^{−πP/2} a tenth of it, and
 /// four points more: without them the errors against Beenakker's sum exceed `tol` at tight
@@ -315,7 +313,7 @@ impl SpectralEwald {
                 u[q] += scale * (re[q] - a2[i] * im[q]);
             }
         };
-        if pos.len() >= PARALLEL_SPHERES {
+        if pos.len() >= PARALLEL_IMAGE_SPHERES {
             out.par_iter_mut().enumerate().for_each(gather);
         } else {
             out.iter_mut().enumerate().for_each(gather);
@@ -360,7 +358,7 @@ impl SpectralEwald {
             }
             *u = v * unit;
         };
-        if pos.len() >= PARALLEL_SPHERES {
+        if pos.len() >= PARALLEL_IMAGE_SPHERES {
             out.par_iter_mut().enumerate().for_each_init(Vec::new, row);
         } else {
             let mut runs = Vec::new();

@@ -12,13 +12,10 @@ use super::rpb;
 use super::Wall;
 use crate::engine::mobility::{block_matrix, self_mobility, Blocks, Mobility, MobilityOperator};
 use crate::engine::open_space::OpenSpace;
+use crate::engine::parallel::PARALLEL_IMAGE_SPHERES;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
 
-/// From this many spheres on, the wall's pair terms run on rayon's threads, each chunk of rows
-/// summing into a buffer of its own (a product is then long enough that the dispatch is a
-/// negligible share of it; timings in the book's design notes).
-const PARALLEL_SPHERES: usize = 64;
 /// The number of row chunks of the parallel pair terms: fixed, so that their sums add up in the
 /// same order on any number of threads; enough to keep a few dozen cores busy.
 const ROW_CHUNKS: usize = 32;
@@ -184,7 +181,7 @@ impl MobilityOperator for WallMobility {
         // the open tensor is invariant under the common shift by the wall's height).
         self.open
             .interaction_velocities(&self.lifted, radii, &self.damped, out);
-        if n >= PARALLEL_SPHERES {
+        if n >= PARALLEL_IMAGE_SPHERES {
             // Fixed chunks of rows, each summed into its own buffer, the buffers added in chunk
             // order: the result does not depend on the threads or how the work was stolen.
             let starts = row_chunks(n, ROW_CHUNKS);
