@@ -6,8 +6,8 @@
 //! pair is a plain difference. Each lane accumulates its own partners and the lanes are summed
 //! in a fixed order: a row depends on neither the thread count nor the vector width.
 
-use super::lanes::{side, Acc};
 use super::arrays::{SlotConst, Soa};
+use super::lanes::{side, Acc};
 use super::{AveragedSystem, CutoffSwitch};
 use crate::engine::neighbours::NeighbourList;
 use crate::engine::simd::{lane_sum, vector_dispatch, LANES};

@@ -42,6 +42,6 @@ pub use terms::{CutoffSwitch, CUTOFF_SWITCH_WIDTH};
 // The names `listed` and `list_rows` read from here.
 use crate::engine::integrators::Problem;
 use crate::engine::model::STATE_PER_SWIMMER;
-use ode::shared_centre_problem;
 use arrays::Soa;
+use ode::shared_centre_problem;
 use terms::pair_weight;
