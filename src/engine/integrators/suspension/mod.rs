@@ -36,19 +36,15 @@
 //! Stage equations (with k including the factor h; autonomous systems skip ∂f/∂t):
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
 
+use super::controller::{self, step_too_small, Adaptive, Attempt, Controller, StepRule};
 use super::rosenbrock::{A, B, B_EMBEDDED, G, GAMMA};
-use super::system::{
-    check_state, fit, stalled, step_too_small, tolerance_failure, GroupJacobian, OdeSystem,
-    Partitioned, Stats, StepFailure, Stepper,
-};
+use super::system::{fit, GroupJacobian, OdeSystem, Partitioned, Stats, StepFailure, Stepper};
 use rayon::prelude::*;
 
 mod refine;
 mod ring;
 
 use refine::{closure, groups_of, path_at};
-
-const MAX_REJECTS: u32 = 60;
 
 /// The largest share of swimmers a step refines: more, and the whole step is taken again shorter.
 pub const MAX_REFINED_FRACTION: f64 = 0.05;
@@ -77,7 +73,11 @@ pub struct Suspension {
     tol: f64,
     /// The first step when none is known (s).
     first_step: f64,
-    h: Option<f64>,
+    control: Controller,
+    /// The stiff groups' Jacobian at the step's start.
+    jac: GroupJacobian,
+    /// Whether the system depends on t (the stages then take ∂f/∂t, in `ft`).
+    with_ft: bool,
     k: [Vec<f64>; 4],
     f: Vec<f64>,
     f0: Vec<f64>,
@@ -238,7 +238,9 @@ impl Suspension {
         Suspension {
             tol,
             first_step,
-            h: None,
+            control: Controller::adaptive(StepRule::Elementary),
+            jac: GroupJacobian::default(),
+            with_ft: false,
             k: Default::default(),
             f: Vec::new(),
             f0: Vec::new(),
@@ -254,16 +256,14 @@ impl Suspension {
         }
     }
 
-    /// One attempt with step h from (t, y): fills y_new and err.
-    #[allow(clippy::too_many_arguments)]
-    fn attempt(
+    /// The coarse step h from (t, y), implicit in the stiff groups `jac`: fills y_new and err.
+    fn coarse(
         &mut self,
         sys: &mut dyn OdeSystem,
         jac: &GroupJacobian,
         t: f64,
         y: &[f64],
         h: f64,
-        with_ft: bool,
         stats: &mut Stats,
     ) {
         let n = y.len();
@@ -287,7 +287,7 @@ impl Suspension {
             for m in 0..n {
                 k[m] = h * self.f[m];
             }
-            if with_ft {
+            if self.with_ft {
                 for m in 0..n {
                     k[m] += h * h * gh * self.ft[m];
                 }
@@ -510,27 +510,20 @@ fn solution(k: &[Vec<f64>; 4], y0: f64, m: usize) -> (f64, f64) {
     (y1, e)
 }
 
-/// The step-size factor after an attempt of error norm `err` (order 3 with an embedded 2): 0.9
-/// err^(−1/3), within 0.2 and 5.
-fn controller_factor(err: f64) -> f64 {
-    if err.is_finite() && err > 0.0 {
-        (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
-    } else if err == 0.0 {
-        5.0
-    } else {
-        0.2
+impl Adaptive for Suspension {
+    fn controller(&mut self) -> &mut Controller {
+        &mut self.control
     }
-}
 
-impl Stepper for Suspension {
-    fn step(
+    /// Buffers sized to y, the rates (and unless the system is autonomous their time
+    /// derivative) at (t, y), and the stiff groups there.
+    fn prepare(
         &mut self,
         sys: &mut dyn OdeSystem,
         t: f64,
-        y: &mut [f64],
-        t_end: f64,
+        y: &[f64],
         stats: &mut Stats,
-    ) -> Result<f64, StepFailure> {
+    ) -> Result<(), StepFailure> {
         let n = y.len();
         let [k1, k2, k3, k4] = &mut self.k;
         fit(
@@ -551,79 +544,64 @@ impl Stepper for Suspension {
         );
         sys.rhs(t, y, &mut self.f0);
         stats.rhs_evals += 1;
-        let with_ft = !sys.autonomous();
-        if with_ft {
+        self.with_ft = !sys.autonomous();
+        if self.with_ft {
             // ∂f/∂t by a forward difference (W-methods need only an approximation).
-            let dt_probe = 1e-7 * (t.abs() + self.h.unwrap_or(self.first_step)).max(1e-12);
+            let h = self.control.h.unwrap_or(self.first_step);
+            let dt_probe = 1e-7 * (t.abs() + h).max(1e-12);
             sys.rhs(t + dt_probe, y, &mut self.ft);
             stats.rhs_evals += 1;
             for m in 0..n {
                 self.ft[m] = (self.ft[m] - self.f0[m]) / dt_probe;
             }
         }
-        let jac = sys.stiff_groups(t, y);
-        let mut h = self.h.unwrap_or(self.first_step);
-        let mut rejects = 0;
-        let scale = sys.time_scale();
-        loop {
-            let span = t_end - t;
-            let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
-            self.attempt(sys, &jac, t, y, h_try, with_ft, stats);
-            let (err, accept) = self.judge(sys, &jac, t, y, h_try, stats);
-            let t_new = if last { t_end } else { t + h_try };
-            let guard = if accept {
-                sys.project(&mut self.y_new);
-                check_state(sys, t_new, &self.y_new)
-            } else {
-                Ok(())
-            };
-            let fac = controller_factor(err);
-            match (accept, guard) {
-                (true, Ok(())) => {
-                    let h_next = h_try * fac;
-                    // A step below the floor that the error estimate does not let grow never
-                    // gets anywhere (a start from a tiny step grows up to 5× a step instead).
-                    if !last && h_next <= h_try && step_too_small(h_next, t, scale) {
-                        return Err(stalled(t_new, h_next, t, scale));
-                    }
-                    y.copy_from_slice(&self.y_new);
-                    stats.steps += 1;
-                    // A step clipped to land on t_end says nothing about the natural step size.
-                    self.h = Some(if last && h_try < h {
-                        h.max(h_next)
-                    } else {
-                        h_next
-                    });
-                    return Ok(t_new);
-                }
-                (true, Err(failure)) => {
-                    stats.rejected += 1;
-                    stats.rejected_by_guard += 1;
-                    rejects += 1;
-                    if rejects >= MAX_REJECTS {
-                        return Err(failure);
-                    }
-                    h = h_try * 0.25;
-                    // Crawling towards the event the guard refuses: stop with it once the step no
-                    // longer advances the time.
-                    if step_too_small(h, t, scale) {
-                        self.h = Some(h_try);
-                        return Err(failure);
-                    }
-                }
-                (false, _) => {
-                    stats.rejected += 1;
-                    rejects += 1;
-                    if rejects >= MAX_REJECTS {
-                        return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
-                    }
-                    h = h_try * fac.min(0.9);
-                    if step_too_small(h, t, scale) {
-                        return Err(stalled(t_new, h, t, scale));
-                    }
-                }
-            }
-        }
+        self.jac = sys.stiff_groups(t, y);
+        Ok(())
+    }
+
+    fn initial_step(
+        &mut self,
+        _sys: &mut dyn OdeSystem,
+        _t: f64,
+        _y: &[f64],
+        _t_end: f64,
+        _stats: &mut Stats,
+    ) -> f64 {
+        self.first_step
+    }
+
+    /// The coarse step, judged swimmer by swimmer (a few refined where that lets it stand).
+    fn attempt(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> Attempt {
+        // The step's Jacobian, lent to the attempt (which borrows the stepper whole).
+        let jac = std::mem::take(&mut self.jac);
+        self.coarse(sys, &jac, t, y, h, stats);
+        let (err, within) = self.judge(sys, &jac, t, y, h, stats);
+        self.jac = jac;
+        Attempt { err, within }
+    }
+
+    fn candidate(&mut self) -> &mut [f64] {
+        &mut self.y_new
+    }
+}
+
+impl Stepper for Suspension {
+    fn step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure> {
+        controller::step(self, sys, t, y, t_end, stats)
     }
 
     fn reset(&mut self) {}

@@ -82,7 +82,6 @@ impl Suspension {
             };
             let norm =
                 Self::subset_step(sub, p, tol, t + tau, h_try, bodies, &changed, floor, &at)?;
-            let fac = controller_factor(norm);
             if norm <= 1.0 && norm.is_finite() {
                 for &m in &comps {
                     sub.y0[m] = sub.y1[m];
@@ -91,10 +90,10 @@ impl Suspension {
                 path.push((tau, comps.iter().map(|&m| sub.y1[m]).collect()));
                 steps += 1;
                 if !(last && h_try < hs) {
-                    hs = h_try * fac;
+                    hs = StepRule::Elementary.after_accept(norm, h_try, false);
                 }
             } else {
-                hs = h_try * fac.min(0.9);
+                hs = StepRule::Elementary.after_reject(norm, h_try);
                 if step_too_small(hs, t + tau, 0.0) || hs < 1e-12 * h {
                     return Err(Refusal::Failed);
                 }
