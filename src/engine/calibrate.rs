@@ -65,7 +65,7 @@ fn measure_crossover(model: Model) -> Crossover {
         Err(e) => {
             return Crossover {
                 size: None,
-                detail: e,
+                detail: e.to_string(),
             }
         }
     };

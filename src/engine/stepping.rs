@@ -246,7 +246,7 @@ pub fn advance_gpu(
     };
     let mut run = match ws.gpu.take() {
         Some(r) if r.fits(model, s.count(), &tableau) => r,
-        _ => GpuRun::new(model, s.count(), tableau.clone()).map_err(|e| invalid!("{e}"))?,
+        _ => GpuRun::new(super::gpu::device()?, model, s.count(), tableau.clone())?,
     };
     let result = match steps {
         GpuSteps::Fixed(dt) => uniform_on_gpu(s, ws, control, t_end, &mut run, dt),
@@ -257,7 +257,7 @@ pub fn advance_gpu(
 }
 
 /// A device run that failed as a whole (lost device, out of memory).
-fn device_failed(e: String, s: &Scene) -> EngineError {
+fn device_failed(e: EngineError, s: &Scene) -> EngineError {
     unsupported(
         format!(
             "the GPU run failed: {e}; the scene keeps its state at t = {:.6e} s",

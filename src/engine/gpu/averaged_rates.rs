@@ -23,9 +23,9 @@ pub struct Pipelines {
 
 impl Pipelines {
     pub(crate) fn new(d: &wgpu::Device, layout: &wgpu::PipelineLayout) -> Self {
-        let m = super::module(d, "averaged_rates", SOURCE);
+        let m = super::common::module(d, "averaged_rates", SOURCE);
         Pipelines {
-            interact: super::pipeline(d, layout, &m, "interact"),
+            interact: super::common::pipeline(d, layout, &m, "interact"),
         }
     }
 }

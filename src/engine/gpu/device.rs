@@ -10,6 +10,7 @@
 //! `SWIMLAB_NO_GPU=1` hides every adapter (to test the fallback); see also
 //! [`quiet_device_selection`].
 
+use crate::engine::error::{invalid, Result};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Keep Mesa's device-selection layer (an implicit Vulkan layer) out of this process when
@@ -101,8 +102,8 @@ fn rank(t: wgpu::DeviceType) -> u8 {
 }
 
 /// The process's GPU device, acquired on first use; `Err` says why there is none and what to do.
-pub fn device() -> Result<Arc<GpuDevice>, String> {
-    static DEVICE: OnceLock<Result<Arc<GpuDevice>, String>> = OnceLock::new();
+pub fn device() -> Result<Arc<GpuDevice>> {
+    static DEVICE: OnceLock<Result<Arc<GpuDevice>>> = OnceLock::new();
     DEVICE.get_or_init(|| acquire().map(Arc::new)).clone()
 }
 
@@ -111,9 +112,11 @@ pub fn available() -> bool {
     device().is_ok()
 }
 
-fn acquire() -> Result<GpuDevice, String> {
+fn acquire() -> Result<GpuDevice> {
     if std::env::var_os("SWIMLAB_NO_GPU").is_some_and(|v| v != "0") {
-        return Err("no GPU adapter: SWIMLAB_NO_GPU is set; unset it to use a GPU".into());
+        return Err(invalid!(
+            "no GPU adapter: SWIMLAB_NO_GPU is set; unset it to use a GPU"
+        ));
     }
     // Instance creation probes the drivers; a broken driver must not take the process down.
     let found = std::panic::catch_unwind(|| {
@@ -128,14 +131,14 @@ fn acquire() -> Result<GpuDevice, String> {
             .max_by_key(|a| rank(a.get_info().device_type));
         (best, seen)
     })
-    .map_err(|_| "the GPU driver failed while listing adapters".to_string())?;
+    .map_err(|_| invalid!("the GPU driver failed while listing adapters"))?;
     let adapter = match found {
         (Some(a), _) => a,
         (None, seen) if seen.is_empty() => {
-            return Err("no GPU adapter found (no Vulkan, Metal or DX12 driver answered); install a driver (on Debian: mesa-vulkan-drivers libvulkan1) or run on the CPU".into())
+            return Err(invalid!("no GPU adapter found (no Vulkan, Metal or DX12 driver answered); install a driver (on Debian: mesa-vulkan-drivers libvulkan1) or run on the CPU"))
         }
         (None, seen) => {
-            return Err(format!(
+            return Err(invalid!(
                 "no GPU adapter offers f64 in shaders (SHADER_F64), which swimlab needs: the drift per period is ~1e-6 of the stroke and f32 cannot carry it; adapters seen: {}",
                 seen.join(", ")
             ))
@@ -144,7 +147,7 @@ fn acquire() -> Result<GpuDevice, String> {
     let info = adapter.get_info();
     let offered = adapter.limits();
     if offered.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS {
-        return Err(format!(
+        return Err(invalid!(
             "the GPU adapter {} allows {} storage buffers per kernel, swimlab's kernels bind {STORAGE_BUFFERS}",
             describe(&info),
             offered.max_storage_buffers_per_shader_stage
@@ -164,7 +167,7 @@ fn acquire() -> Result<GpuDevice, String> {
         memory_hints: wgpu::MemoryHints::Performance,
         trace: wgpu::Trace::Off,
     }))
-    .map_err(|e| format!("the GPU adapter {} refused a device: {e}", describe(&info)))?;
+    .map_err(|e| invalid!("the GPU adapter {} refused a device: {e}", describe(&info)))?;
     let errors = Arc::new(Mutex::new(Vec::new()));
     let sink = errors.clone();
     device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {

@@ -22,10 +22,10 @@ pub struct Pipelines {
 
 impl Pipelines {
     pub(crate) fn new(d: &wgpu::Device, layout: &wgpu::PipelineLayout) -> Self {
-        let m = super::module(d, "micro_rates", SOURCE);
+        let m = super::common::module(d, "micro_rates", SOURCE);
         Pipelines {
-            place: super::pipeline(d, layout, &m, "place"),
-            interact: super::pipeline(d, layout, &m, "interact"),
+            place: super::common::pipeline(d, layout, &m, "place"),
+            interact: super::common::pipeline(d, layout, &m, "interact"),
         }
     }
 }

@@ -21,15 +21,15 @@ pub struct Pipelines {
 
 impl Pipelines {
     pub(crate) fn new(d: &wgpu::Device, layout: &wgpu::PipelineLayout) -> Self {
-        let m = super::module(d, "rk_stages", SOURCE);
+        let m = super::common::module(d, "rk_stages", SOURCE);
         Pipelines {
-            stage_state: super::pipeline(d, layout, &m, "stage_state"),
-            combine: super::pipeline(d, layout, &m, "combine"),
-            commit: super::pipeline(d, layout, &m, "commit"),
-            begin_attempt: super::pipeline(d, layout, &m, "begin_attempt"),
-            error_part: super::pipeline(d, layout, &m, "error_part"),
-            decide: super::pipeline(d, layout, &m, "decide"),
-            commit_attempt: super::pipeline(d, layout, &m, "commit_attempt"),
+            stage_state: super::common::pipeline(d, layout, &m, "stage_state"),
+            combine: super::common::pipeline(d, layout, &m, "combine"),
+            commit: super::common::pipeline(d, layout, &m, "commit"),
+            begin_attempt: super::common::pipeline(d, layout, &m, "begin_attempt"),
+            error_part: super::common::pipeline(d, layout, &m, "error_part"),
+            decide: super::common::pipeline(d, layout, &m, "decide"),
+            commit_attempt: super::common::pipeline(d, layout, &m, "commit_attempt"),
         }
     }
 }

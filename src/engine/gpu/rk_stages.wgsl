@@ -81,7 +81,8 @@ fn commit(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// The CPU's Dopri5 controller (integrators/dopri5.rs): Hairer's PI controller.
+// The CPU's adaptive controller with its PI rule (integrators/controller.rs, `StepRule::Pi`, as
+// dopri5 runs it) and its MAX_REJECTS.
 const SAFETY: f64 = 0.9lf;
 const BETA: f64 = 0.04lf;
 const FAC_MIN: f64 = 0.2lf;

@@ -1,7 +1,10 @@
 //! A scene's device buffers and the encoding of whole runs: the host side of the GPU backend.
 
+use super::common::WORKGROUP;
+use super::device::GpuDevice;
+use super::kernels::Kernels;
 use super::rk_stages::{StageParams, Tableau};
-use super::{kernels, GpuDevice, Kernels, WORKGROUP};
+use crate::engine::error::{invalid, Result};
 use crate::engine::mobility::Mobility;
 use crate::engine::model::{Coefficients, STATE_PER_SWIMMER};
 use crate::engine::swimmer::Dumbbell;
@@ -195,9 +198,9 @@ fn readback(dev: &GpuDevice, label: &str, bytes: usize) -> wgpu::Buffer {
 }
 
 impl GpuRun {
-    /// Buffers for `n` swimmers of `model` stepped with `tableau`.
-    pub fn new(model: GpuModel, n: usize, tableau: Tableau) -> Result<Self, String> {
-        let (dev, kernels) = kernels()?;
+    /// Buffers on `dev` for `n` swimmers of `model` stepped with `tableau`.
+    pub fn new(dev: Arc<GpuDevice>, model: GpuModel, n: usize, tableau: Tableau) -> Result<Self> {
+        let kernels = Kernels::on(&dev)?;
         let nstate = STATE_PER_SWIMMER * n;
         let f64s = |count: usize| count * std::mem::size_of::<f64>();
         let scope = dev.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
@@ -258,7 +261,7 @@ impl GpuRun {
         let read_state = readback(&dev, "read state", f64s(nstate));
         let read_control = readback(&dev, "read control", std::mem::size_of::<Control>());
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(format!(
+            return Err(invalid!(
                 "the GPU has no room for {n} swimmers: {e}; use fewer swimmers or the CPU"
             ));
         }
@@ -307,7 +310,7 @@ impl GpuRun {
         y: &mut [f64],
         steps: UniformSteps,
         interrupted: &dyn Fn() -> bool,
-    ) -> Result<RunOutcome, String> {
+    ) -> Result<RunOutcome> {
         let UniformSteps {
             t0,
             h,
@@ -388,7 +391,7 @@ impl GpuRun {
         h: f64,
         steps: u64,
         interrupted: &dyn Fn() -> bool,
-    ) -> Result<RunOutcome, String> {
+    ) -> Result<RunOutcome> {
         let params = self.params(t0, h, 0.0);
         let q = &self.dev.queue;
         q.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -438,9 +441,9 @@ impl GpuRun {
         scale: &[f64],
         steps: AdaptiveSteps,
         interrupted: &dyn Fn() -> bool,
-    ) -> Result<AdaptiveReport, String> {
+    ) -> Result<AdaptiveReport> {
         if !self.tableau.is_adaptive() {
-            return Err("these device buffers hold a fixed-step method".into());
+            return Err(invalid!("these device buffers hold a fixed-step method"));
         }
         self.upload(swimmers, base, y);
         let q = &self.dev.queue;
@@ -587,12 +590,12 @@ impl GpuRun {
         });
     }
 
-    fn read_control(&self) -> Result<Control, String> {
+    fn read_control(&self) -> Result<Control> {
         let bytes = self.map_read(&self.read_control, std::mem::size_of::<Control>())?;
         Ok(bytemuck::pod_read_unaligned(&bytes))
     }
 
-    fn read_state(&self, y: &mut [f64]) -> Result<(), String> {
+    fn read_state(&self, y: &mut [f64]) -> Result<()> {
         let size = std::mem::size_of_val(y);
         let mut enc = self
             .dev
@@ -610,7 +613,7 @@ impl GpuRun {
     }
 
     /// Wait for the queue, then copy the first `size` bytes of a readback buffer.
-    fn map_read(&self, buf: &wgpu::Buffer, size: usize) -> Result<Vec<u8>, String> {
+    fn map_read(&self, buf: &wgpu::Buffer, size: usize) -> Result<Vec<u8>> {
         let slice = buf.slice(..size as u64);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -619,19 +622,19 @@ impl GpuRun {
         self.dev
             .device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("the GPU stopped answering: {e}"))?;
+            .map_err(|e| invalid!("the GPU stopped answering: {e}"))?;
         let errors = self.dev.take_errors();
         if !errors.is_empty() {
-            return Err(format!("the GPU reported: {}", errors.join("; ")));
+            return Err(invalid!("the GPU reported: {}", errors.join("; ")));
         }
         match rx.recv() {
             Ok(Ok(())) => {}
-            Ok(Err(e)) => return Err(format!("reading back from the GPU failed: {e}")),
-            Err(_) => return Err("reading back from the GPU never completed".into()),
+            Ok(Err(e)) => return Err(invalid!("reading back from the GPU failed: {e}")),
+            Err(_) => return Err(invalid!("reading back from the GPU never completed")),
         }
         let out = slice
             .get_mapped_range()
-            .map_err(|e| format!("reading back from the GPU failed: {e}"))?
+            .map_err(|e| invalid!("reading back from the GPU failed: {e}"))?
             .to_vec();
         buf.unmap();
         Ok(out)

@@ -1,10 +1,9 @@
-//! Dormand-Prince 5(4) with embedded error estimate, FSAL, and Hairer's PI step-size controller
-//! (Hairer, Nørsett & Wanner, *Solving ODEs I*, II.4 and the `DOPRI5` code).
+//! Dormand-Prince 5(4) with embedded error estimate and FSAL, driven by the adaptive controller
+//! with Hairer's PI step-size rule (Hairer, Nørsett & Wanner, *Solving ODEs I*, II.4 and the
+//! `DOPRI5` code).
 
-use super::system::{
-    check_state, fit, stalled, step_too_small, tolerance_failure, OdeSystem, Stats, StepFailure,
-    Stepper,
-};
+use super::controller::{self, Adaptive, Attempt, Controller, StepRule};
+use super::system::{fit, OdeSystem, Stats, StepFailure, Stepper};
 
 /// Stage times (the GPU backend takes the same tableau).
 pub const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
@@ -49,23 +48,13 @@ pub const E: [f64; 7] = [
     22.0 / 525.0,
     -1.0 / 40.0,
 ];
-const SAFETY: f64 = 0.9;
-const BETA: f64 = 0.04;
-/// A step may shrink at most 5× and grow at most 10× at once.
-const FAC_MIN: f64 = 0.2;
-const FAC_MAX: f64 = 10.0;
-/// Consecutive rejected attempts after which the step is given up.
-const MAX_REJECTS: u32 = 60;
 
 /// Adaptive Dormand-Prince 5(4) with relative tolerance `rtol` (per component, against
 /// [`OdeSystem::error_scale`]).
 #[derive(Debug, Clone)]
 pub struct Dopri5 {
     rtol: f64,
-    /// Fixed step (no error control), for convergence-order studies.
-    fixed: Option<f64>,
-    h: Option<f64>,
-    fac_old: f64,
+    control: Controller,
     fsal_valid: bool,
     k: [Vec<f64>; 7],
     tmp: Vec<f64>,
@@ -78,14 +67,20 @@ impl Dopri5 {
     pub fn new(rtol: f64) -> Self {
         Dopri5 {
             rtol,
-            fixed: None,
-            h: None,
-            fac_old: 1e-4,
+            control: Controller::adaptive(StepRule::pi()),
             fsal_valid: false,
             k: Default::default(),
             tmp: Vec::new(),
             y_new: Vec::new(),
             scale: Vec::new(),
+        }
+    }
+
+    /// The Dormand-Prince 5th-order formula with fixed steps of at most `dt` and no error control.
+    pub fn fixed_step(dt: f64) -> Self {
+        Dopri5 {
+            control: Controller::fixed(StepRule::pi(), dt),
+            ..Dopri5::new(1.0)
         }
     }
 
@@ -101,7 +96,7 @@ impl Dopri5 {
 
     /// Buffers sized to y, the error scale at y, and the rates at (t, y) in the first stage slot
     /// unless they are there already (first same as last).
-    fn prepare(&mut self, sys: &mut dyn OdeSystem, t: f64, y: &[f64], stats: &mut Stats) {
+    fn start(&mut self, sys: &mut dyn OdeSystem, t: f64, y: &[f64], stats: &mut Stats) {
         let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
         fit(
             y.len(),
@@ -126,14 +121,6 @@ impl Dopri5 {
         }
     }
 
-    /// The Dormand-Prince 5th-order formula with fixed steps of at most `dt` and no error control.
-    pub fn fixed_step(dt: f64) -> Self {
-        Dopri5 {
-            fixed: Some(dt),
-            ..Dopri5::new(1.0)
-        }
-    }
-
     /// RMS over components of (embedded error estimate)/(rtol · scale), from the stages in `k`.
     fn error_norm(&self, h: f64) -> f64 {
         let n = self.scale.len();
@@ -147,7 +134,7 @@ impl Dopri5 {
     }
 
     /// Hairer's starting step: a step whose Euler error is about the tolerance.
-    fn initial_step(
+    fn hairer_step(
         &mut self,
         sys: &mut dyn OdeSystem,
         t: f64,
@@ -179,6 +166,67 @@ impl Dopri5 {
     }
 }
 
+impl Adaptive for Dopri5 {
+    fn controller(&mut self) -> &mut Controller {
+        &mut self.control
+    }
+
+    fn prepare(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        stats: &mut Stats,
+    ) -> Result<(), StepFailure> {
+        self.start(sys, t, y, stats);
+        Ok(())
+    }
+
+    fn initial_step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        _t_end: f64,
+        stats: &mut Stats,
+    ) -> f64 {
+        self.hairer_step(sys, t, y, stats)
+    }
+
+    fn attempt(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> Attempt {
+        let n = y.len();
+        for s in 1..7 {
+            for i in 0..n {
+                let mut acc = 0.0;
+                for (j, a) in A[s][..s].iter().enumerate() {
+                    acc += a * self.k[j][i];
+                }
+                self.tmp[i] = y[i] + h * acc;
+            }
+            sys.rhs(t + C[s] * h, &self.tmp, &mut self.k[s]);
+        }
+        stats.rhs_evals += 6;
+        // Stage 7 was evaluated at the 5th-order solution (A[6] = b), which is in tmp.
+        self.y_new.copy_from_slice(&self.tmp);
+        Attempt::of_norm(self.error_norm(h))
+    }
+
+    fn candidate(&mut self) -> &mut [f64] {
+        &mut self.y_new
+    }
+
+    fn accepted(&mut self) {
+        self.k.swap(0, 6);
+    }
+}
+
 impl Stepper for Dopri5 {
     fn step(
         &mut self,
@@ -188,111 +236,12 @@ impl Stepper for Dopri5 {
         t_end: f64,
         stats: &mut Stats,
     ) -> Result<f64, StepFailure> {
-        let n = y.len();
-        self.prepare(sys, t, y, stats);
-        let mut h = match (self.fixed, self.h) {
-            (Some(dt), _) => super::system::uniform_step(t, t_end, dt).0,
-            (None, Some(h)) => h,
-            (None, None) => self.initial_step(sys, t, y, stats),
-        };
-        let mut rejected_last = false;
-        let mut rejects = 0;
-        let scale = sys.time_scale();
-        loop {
-            let span = t_end - t;
-            let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
-            for s in 1..7 {
-                for i in 0..n {
-                    let mut acc = 0.0;
-                    for (j, a) in A[s][..s].iter().enumerate() {
-                        acc += a * self.k[j][i];
-                    }
-                    self.tmp[i] = y[i] + h_try * acc;
-                }
-                sys.rhs(t + C[s] * h_try, &self.tmp, &mut self.k[s]);
-            }
-            stats.rhs_evals += 6;
-            // Stage 7 was evaluated at the 5th-order solution (A[6] = b), which is in tmp.
-            self.y_new.copy_from_slice(&self.tmp);
-            let err_norm = self.error_norm(h_try);
-            let fac11 = err_norm.powf(0.2 - BETA * 0.75);
-            let t_new = if last { t_end } else { t + h_try };
-            let accept = self.fixed.is_some() || (err_norm <= 1.0 && err_norm.is_finite());
-            let guard = if accept {
-                sys.project(&mut self.y_new);
-                check_state(sys, t_new, &self.y_new)
-            } else {
-                Ok(())
-            };
-            match (accept, guard) {
-                (true, Ok(())) => {
-                    let fac = (fac11 / self.fac_old.powf(BETA) / SAFETY)
-                        .clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                    let mut h_next = h_try / fac;
-                    if rejected_last {
-                        h_next = h_next.min(h_try);
-                    }
-                    // A step below the floor that the error estimate does not let grow never
-                    // gets anywhere (a start from a tiny step grows up to 10× a step instead).
-                    if self.fixed.is_none()
-                        && !last
-                        && h_next <= h_try
-                        && step_too_small(h_next, t, scale)
-                    {
-                        return Err(stalled(t_new, h_next, t, scale));
-                    }
-                    self.fac_old = err_norm.max(1e-4);
-                    // A step clipped to land on t_end says nothing about the natural step size.
-                    self.h = Some(if last && h_try < h {
-                        h.max(h_next)
-                    } else {
-                        h_next
-                    });
-                    y.copy_from_slice(&self.y_new);
-                    self.k.swap(0, 6);
-                    stats.steps += 1;
-                    return Ok(t_new);
-                }
-                (true, Err(failure)) => {
-                    stats.rejected += 1;
-                    stats.rejected_by_guard += 1;
-                    rejects += 1;
-                    if rejects >= MAX_REJECTS {
-                        self.h = Some(h_try);
-                        return Err(failure);
-                    }
-                    h = h_try * 0.25;
-                    // Crawling towards the event the guard refuses (spheres about to touch):
-                    // stop with it once the step no longer advances the time.
-                    if step_too_small(h, t, scale) {
-                        self.h = Some(h_try);
-                        return Err(failure);
-                    }
-                }
-                (false, _) => {
-                    stats.rejected += 1;
-                    rejects += 1;
-                    if rejects >= MAX_REJECTS {
-                        return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
-                    }
-                    let shrink = if err_norm.is_finite() {
-                        (fac11 / SAFETY).min(1.0 / FAC_MIN)
-                    } else {
-                        1.0 / FAC_MIN
-                    };
-                    h = h_try / shrink;
-                    if step_too_small(h, t, scale) {
-                        return Err(stalled(t_new, h, t, scale));
-                    }
-                }
-            }
-            rejected_last = true;
-        }
+        controller::step(self, sys, t, y, t_end, stats)
     }
 
     fn reset(&mut self) {
         self.fsal_valid = false;
-        self.fac_old = 1e-4;
+        self.control.reset(StepRule::pi());
     }
 
     fn next_step(
@@ -302,18 +251,18 @@ impl Stepper for Dopri5 {
         y: &[f64],
         stats: &mut Stats,
     ) -> Option<f64> {
-        if self.fixed.is_some() {
+        if self.control.is_fixed() {
             return None;
         }
-        if self.h.is_none() {
-            self.prepare(sys, t, y, stats);
-            self.h = Some(self.initial_step(sys, t, y, stats));
+        if self.control.h.is_none() {
+            self.start(sys, t, y, stats);
+            self.control.h = Some(self.hairer_step(sys, t, y, stats));
         }
-        self.h
+        self.control.h
     }
 
     fn continue_with_step(&mut self, h: f64) {
-        self.h = Some(h);
+        self.control.h = Some(h);
         self.fsal_valid = false;
     }
 }

@@ -3,10 +3,13 @@
 //! Fixed-step methods ([`Euler`], [`Rk4`]) split a run into equal steps no longer than `dt` so that a
 //! run of any duration lands exactly on its end time. The adaptive [`Dopri5`] controls the error
 //! per component against [`OdeSystem::error_scale`], which the models set to the size of the slow
-//! drift rather than of the absolute positions (see `engine::micro`). With thermal noise on
+//! drift rather than of the absolute positions (see `engine::micro`). The adaptive steppers
+//! ([`Dopri5`], [`Rosenbrock`], [`Suspension`]) supply their attempt and error estimate; one
+//! controller (`controller.rs`) accepts or rejects it and chooses the next step. With thermal noise on
 //! ([`OdeSystem::noise`]), [`Euler`] is Euler-Maruyama and [`Platen`] a weak second-order scheme;
 //! their noise comes from a counter-based generator ([`StepDraws`]).
 
+mod controller;
 mod dopri5;
 mod euler;
 mod philox;

@@ -6,15 +6,14 @@
 //! spring, drag and hydrodynamics, [`OdeSystem::jacobian_blocks`]), and the hydrodynamic coupling
 //! between dumbbells stays explicit. A step then costs four right-hand sides (O(S²)), one more for
 //! ∂f/∂t, the blocks by finite differences of each dumbbell alone (O(S)), and S small LU solves per
-//! stage (O(S)): no dense 6S×6S algebra, and no step limit from the spring.
+//! stage (O(S)): no dense 6S×6S algebra, and no step limit from the spring. The adaptive
+//! controller drives it with the elementary rule of an order-3 pair.
 //!
 //! Stage equations (Hairer & Wanner, IV.7, with k including the factor h):
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
 
-use super::system::{
-    check_state, fit, stalled, step_too_small, tolerance_failure, Problem, StepFailure,
-};
-use super::{OdeSystem, Stats, Stepper};
+use super::controller::{self, Adaptive, Attempt, Controller, StepRule};
+use super::system::{fit, OdeSystem, Problem, Stats, StepFailure, Stepper};
 use nalgebra::{DMatrix, DVector};
 
 pub(super) const GAMMA: f64 = 4.358_665_215_084_59e-1;
@@ -47,15 +46,14 @@ pub(super) const B_EMBEDDED: [f64; 4] = [
     0.5,
     2.179_332_607_542_295e-1,
 ];
-const MAX_REJECTS: u32 = 60;
-
 /// Adaptive ROS34PW2 with relative tolerance `rtol` (against [`OdeSystem::error_scale`]), or with
 /// fixed steps for convergence studies.
 #[derive(Debug, Clone)]
 pub struct Rosenbrock {
     rtol: f64,
-    fixed: Option<f64>,
-    h: Option<f64>,
+    control: Controller,
+    /// Size of the system's Jacobian blocks at this step (0: none).
+    bs: usize,
     k: [Vec<f64>; 4],
     f: Vec<f64>,
     f0: Vec<f64>,
@@ -76,8 +74,8 @@ impl Rosenbrock {
     pub fn new(rtol: f64) -> Self {
         Rosenbrock {
             rtol,
-            fixed: None,
-            h: None,
+            control: Controller::adaptive(StepRule::Elementary),
+            bs: 0,
             k: Default::default(),
             f: Vec::new(),
             f0: Vec::new(),
@@ -95,22 +93,22 @@ impl Rosenbrock {
     /// Fixed steps of at most `dt`, no error control (for order studies).
     pub fn fixed_step(dt: f64) -> Self {
         Rosenbrock {
-            fixed: Some(dt),
+            control: Controller::fixed(StepRule::Elementary, dt),
             ..Rosenbrock::new(1.0)
         }
     }
 
-    /// One attempt with step h from (t, y): fills y_new, returns the error norm.
-    fn attempt(
+    /// The stages of a step h from (t, y) with W factored for h: fills y_new, returns the error
+    /// norm.
+    fn stages(
         &mut self,
         sys: &mut dyn OdeSystem,
         t: f64,
         y: &[f64],
         h: f64,
-        bs: usize,
         stats: &mut Stats,
     ) -> f64 {
-        let n = y.len();
+        let (n, bs) = (y.len(), self.bs);
         let gamma_hat = |i: usize| GAMMA + G[i].iter().sum::<f64>();
         let c = |i: usize| A[i].iter().sum::<f64>();
         for i in 0..4 {
@@ -170,15 +168,20 @@ impl Rosenbrock {
     }
 }
 
-impl Stepper for Rosenbrock {
-    fn step(
+impl Adaptive for Rosenbrock {
+    fn controller(&mut self) -> &mut Controller {
+        &mut self.control
+    }
+
+    /// Buffers sized to y, the error scale, the rates and their time derivative at (t, y), and
+    /// the Jacobian blocks there.
+    fn prepare(
         &mut self,
         sys: &mut dyn OdeSystem,
         t: f64,
-        y: &mut [f64],
-        t_end: f64,
+        y: &[f64],
         stats: &mut Stats,
-    ) -> Result<f64, StepFailure> {
+    ) -> Result<(), StepFailure> {
         let n = y.len();
         let [k1, k2, k3, k4] = &mut self.k;
         fit(
@@ -198,6 +201,7 @@ impl Stepper for Rosenbrock {
             ],
         );
         let bs = sys.jacobian_block();
+        self.bs = bs;
         if self.block.len() != bs {
             self.block = DVector::zeros(bs);
         }
@@ -215,7 +219,7 @@ impl Stepper for Rosenbrock {
         sys.error_scale(y, &mut self.scale);
         sys.rhs(t, y, &mut self.f0);
         // ∂f/∂t by a forward difference (W-methods need only an approximation).
-        let dt_probe = 1e-7 * (t.abs() + self.h.unwrap_or(1e-6)).max(1e-12);
+        let dt_probe = 1e-7 * (t.abs() + self.control.h.unwrap_or(1e-6)).max(1e-12);
         sys.rhs(t + dt_probe, y, &mut self.ft);
         for m in 0..n {
             self.ft[m] = (self.ft[m] - self.f0[m]) / dt_probe;
@@ -225,90 +229,55 @@ impl Stepper for Rosenbrock {
         if bs > 0 {
             sys.jacobian_blocks(t, y, &mut self.jac);
         }
-        let mut h = match (self.fixed, self.h) {
-            (Some(dt), _) => super::system::uniform_step(t, t_end, dt).0,
-            (None, Some(h)) => h,
-            (None, None) => (t_end - t).min(1e-3 * (t_end - t).max(1e-9)),
-        };
-        let mut rejects = 0;
-        let scale = sys.time_scale();
-        loop {
-            let span = t_end - t;
-            let (h_try, last) = if h >= span { (span, true) } else { (h, false) };
-            self.lus = (0..n.checked_div(bs).unwrap_or(0))
-                .map(|blk| {
-                    let jb = &self.jac[blk * bs * bs..(blk + 1) * bs * bs];
-                    let w = DMatrix::from_fn(bs, bs, |r, q| {
-                        f64::from(u8::from(r == q)) - h_try * GAMMA * jb[r * bs + q]
-                    });
-                    w.lu()
-                })
-                .collect();
-            let err = self.attempt(sys, t, y, h_try, bs, stats);
-            let t_new = if last { t_end } else { t + h_try };
-            let fixed = self.fixed.is_some();
-            let accept = fixed || (err <= 1.0 && err.is_finite());
-            let guard = if accept {
-                sys.project(&mut self.y_new);
-                check_state(sys, t_new, &self.y_new)
-            } else {
-                Ok(())
-            };
-            let fac = if err.is_finite() && err > 0.0 {
-                (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
-            } else if err == 0.0 {
-                5.0
-            } else {
-                0.2
-            };
-            match (accept, guard) {
-                (true, Ok(())) => {
-                    let h_next = h_try * fac;
-                    // A step below the floor that the error estimate does not let grow never
-                    // gets anywhere (a start from a tiny step grows up to 5× a step instead).
-                    if self.fixed.is_none()
-                        && !last
-                        && h_next <= h_try
-                        && step_too_small(h_next, t, scale)
-                    {
-                        return Err(stalled(t_new, h_next, t, scale));
-                    }
-                    y.copy_from_slice(&self.y_new);
-                    stats.steps += 1;
-                    self.h = Some(if last && h_try < h {
-                        h.max(h_next)
-                    } else {
-                        h_next
-                    });
-                    return Ok(t_new);
-                }
-                (true, Err(failure)) => {
-                    stats.rejected += 1;
-                    stats.rejected_by_guard += 1;
-                    rejects += 1;
-                    if fixed || rejects >= MAX_REJECTS {
-                        return Err(failure);
-                    }
-                    h = h_try * 0.25;
-                    // Crawling towards the event the guard refuses (spheres about to touch):
-                    // stop with it once the step no longer advances the time.
-                    if step_too_small(h, t, scale) {
-                        self.h = Some(h_try);
-                        return Err(failure);
-                    }
-                }
-                (false, _) => {
-                    stats.rejected += 1;
-                    rejects += 1;
-                    if rejects >= MAX_REJECTS {
-                        return Err(tolerance_failure(t_new, h_try, MAX_REJECTS));
-                    }
-                    h = h_try * fac.min(0.9);
-                    if step_too_small(h, t, scale) {
-                        return Err(stalled(t_new, h, t, scale));
-                    }
-                }
-            }
-        }
+        Ok(())
+    }
+
+    fn initial_step(
+        &mut self,
+        _sys: &mut dyn OdeSystem,
+        t: f64,
+        _y: &[f64],
+        t_end: f64,
+        _stats: &mut Stats,
+    ) -> f64 {
+        (t_end - t).min(1e-3 * (t_end - t).max(1e-9))
+    }
+
+    fn attempt(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        stats: &mut Stats,
+    ) -> Attempt {
+        let (n, bs) = (y.len(), self.bs);
+        self.lus = (0..n.checked_div(bs).unwrap_or(0))
+            .map(|blk| {
+                let jb = &self.jac[blk * bs * bs..(blk + 1) * bs * bs];
+                let w = DMatrix::from_fn(bs, bs, |r, q| {
+                    f64::from(u8::from(r == q)) - h * GAMMA * jb[r * bs + q]
+                });
+                w.lu()
+            })
+            .collect();
+        Attempt::of_norm(self.stages(sys, t, y, h, stats))
+    }
+
+    fn candidate(&mut self) -> &mut [f64] {
+        &mut self.y_new
+    }
+}
+
+impl Stepper for Rosenbrock {
+    fn step(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, StepFailure> {
+        controller::step(self, sys, t, y, t_end, stats)
     }
 }

@@ -15,7 +15,7 @@ pub trait OdeSystem {
     fn error_scale(&self, y: &[f64], scale: &mut [f64]);
     /// The time the dynamics unfold on (s): the shortest stroke period for the swimmer models.
     /// An adaptive step below [`MIN_RELATIVE_INTERVAL`] of it (or of t, whichever is longer)
-    /// stops the run ([`step_too_small`]): one such period would take more than 1e12 steps. 0
+    /// stops the run ([`step_too_small`](super::controller::step_too_small)): one such period would take more than 1e12 steps. 0
     /// (the default): steps are held to t alone.
     fn time_scale(&self) -> f64 {
         0.0
@@ -443,64 +443,6 @@ pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<
     }
     sys.check(t, y)
         .map_err(|problem| StepFailure { time: t, problem })
-}
-
-/// The failure of an adaptive step whose error estimate stayed above tolerance after `rejects`
-/// reductions (shared by the adaptive steppers).
-pub(crate) fn tolerance_failure(time: f64, h: f64, rejects: u32) -> StepFailure {
-    StepFailure {
-        time,
-        problem: Problem {
-            swimmer: None,
-            cause: format!(
-                "the error estimate stayed above tolerance after {rejects} step reductions (h = {h:e} s)"
-            ),
-            hint: "loosen the tolerance, or check the scene for NaN or nearly touching spheres"
-                .into(),
-            fixes: Vec::new(),
-        },
-    }
-}
-
-/// The shortest adaptive step (s) at time `t` of a system whose time scale is `scale`
-/// ([`OdeSystem::time_scale`]): [`MIN_RELATIVE_INTERVAL`] of the longer of the two. Below it a
-/// step no longer advances t measurably, or a period would take more than 1e12 steps: at t = 0
-/// the time alone sets no floor, and a step the error estimate keeps that small would creep on
-/// for ever.
-pub(crate) fn step_floor(t: f64, scale: f64) -> f64 {
-    MIN_RELATIVE_INTERVAL * t.abs().max(scale)
-}
-
-/// Whether an adaptive step `h` (s) at time `t` is below [`step_floor`]. An adaptive method that
-/// shrinks its step there is crawling towards an event it cannot pass (two spheres about to
-/// touch, where every larger step is refused by the contact guard), or its rates are far beyond
-/// what the scene's time scale can carry; it stops with that event's error, or [`stalled`]'s,
-/// instead of spinning for ever.
-pub(crate) fn step_too_small(h: f64, t: f64, scale: f64) -> bool {
-    h < step_floor(t, scale)
-}
-
-/// The error of an adaptive method whose error estimate held its step `h` at time `time` below
-/// [`step_floor`] of the start time `t` and the time scale `scale`.
-pub(crate) fn stalled(time: f64, h: f64, t: f64, scale: f64) -> StepFailure {
-    let floor = step_floor(t, scale);
-    let basis = if scale > t.abs() {
-        format!("{MIN_RELATIVE_INTERVAL:e} of the stroke period {scale:.6e} s: one period would take more than {:e} steps", 1.0 / MIN_RELATIVE_INTERVAL)
-    } else {
-        format!("what f64 can advance the time by at t = {t:.6e} s")
-    };
-    StepFailure {
-        time,
-        problem: Problem {
-            swimmer: None,
-            cause: format!(
-                "the step fell to {h:.3e} s, below {floor:.3e} s ({basis}), to keep the error estimate within tolerance"
-            ),
-            hint: "loosen the tolerance, or check the scene for NaN or nearly touching spheres"
-                .into(),
-            fixes: Vec::new(),
-        },
-    }
 }
 
 /// The finest interval (a step, a recorder's period) relative to the times it is used at: below

@@ -3,7 +3,76 @@
 //! others from the coarse step; groups that read none of each other apart, on rayon's threads
 //! when the system allows (see the module docs of [`super`]).
 
-use super::*;
+use super::scratch::{Path, Refinement, Rounds};
+use super::stepper::Suspension;
+use crate::engine::integrators::controller::{step_too_small, StepRule};
+use crate::engine::integrators::system::{GroupJacobian, Partitioned};
+use rayon::prelude::*;
+
+/// Refined groups from this many on are refined on rayon's threads (when the system allows).
+pub const PARALLEL_GROUPS: usize = 2;
+
+/// The most steps a refinement may take across one coarse step.
+pub const MAX_SUBSTEPS: u32 = 100_000;
+
+/// A refined group's outcome: its state components, its path across the coarse step and the
+/// steps it took.
+pub(super) struct Refined {
+    pub(super) comps: Vec<usize>,
+    pub(super) path: Path,
+    pub(super) steps: u64,
+}
+
+/// Why a refinement or a subset step stopped.
+#[derive(Debug)]
+pub(super) enum Refusal {
+    /// A contact forms between the bodies stepped and others: the bodies of every such contact.
+    Crossing(Vec<usize>),
+    /// The steps shrank to nothing.
+    Failed,
+    /// The system's neighbour data must change first (read shared, it cannot).
+    Relist,
+}
+
+/// How a refinement reaches the system: owned (rates through [`Partitioned::rhs_bodies`], which
+/// may update the system) or shared among threads (through [`Partitioned::rates_shared`]).
+pub(super) enum Access<'a> {
+    Own(&'a mut dyn Partitioned),
+    Shared(&'a dyn Partitioned),
+}
+
+impl Access<'_> {
+    pub(super) fn get(&self) -> &dyn Partitioned {
+        match self {
+            Access::Own(p) => &**p,
+            Access::Shared(p) => *p,
+        }
+    }
+
+    /// The rates of `bodies` at `y` into `dy` (see [`Partitioned::rhs_bodies`]).
+    pub(super) fn rates(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        bodies: &[usize],
+        changed: &[usize],
+        dy: &mut [f64],
+    ) -> Result<(), Refusal> {
+        match self {
+            Access::Own(p) => {
+                p.rhs_bodies(t, y, bodies, changed, dy);
+                Ok(())
+            }
+            Access::Shared(p) => {
+                if p.rates_shared(y, bodies, changed, dy) {
+                    Ok(())
+                } else {
+                    Err(Refusal::Relist)
+                }
+            }
+        }
+    }
+}
 
 impl Suspension {
     /// This thread's scratch sized to the state `y`, with the working states at `y` (a
@@ -82,7 +151,6 @@ impl Suspension {
             };
             let norm =
                 Self::subset_step(sub, p, tol, t + tau, h_try, bodies, &changed, floor, &at)?;
-            let fac = controller_factor(norm);
             if norm <= 1.0 && norm.is_finite() {
                 for &m in &comps {
                     sub.y0[m] = sub.y1[m];
@@ -91,10 +159,10 @@ impl Suspension {
                 path.push((tau, comps.iter().map(|&m| sub.y1[m]).collect()));
                 steps += 1;
                 if !(last && h_try < hs) {
-                    hs = h_try * fac;
+                    hs = StepRule::Elementary.after_accept(norm, h_try, false);
                 }
             } else {
-                hs = h_try * fac.min(0.9);
+                hs = StepRule::Elementary.after_reject(norm, h_try);
                 if step_too_small(hs, t + tau, 0.0) || hs < 1e-12 * h {
                     return Err(Refusal::Failed);
                 }

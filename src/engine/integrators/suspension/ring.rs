@@ -2,7 +2,15 @@
 //! path instead of the coarse step, by more than their share of the tolerance; they are stepped
 //! again reading that path (see the module docs of [`super`]).
 
-use super::*;
+use super::refine::{closure, groups_of, path_at, Access, Refusal, PARALLEL_GROUPS};
+use super::scratch::{Path, Refinement, RingPart, Rounds};
+use super::stepper::Suspension;
+use crate::engine::integrators::system::{GroupJacobian, Partitioned};
+use rayon::prelude::*;
+
+/// The share of the tolerance by which reading the refined swimmers' path instead of their coarse
+/// states may change a neighbour's step before the neighbour is stepped again.
+pub const RING_SHARE: f64 = 0.1;
 
 impl Suspension {
     /// The swimmers to step again around the refined ones (`refined`, their paths in
