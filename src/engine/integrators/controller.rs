@@ -351,7 +351,6 @@ pub(crate) fn stalled(time: f64, h: f64, t: f64, scale: f64) -> StepFailure {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Dopri5, Rosenbrock, Stepper};
     use super::*;
 
     /// dy/dt = −y whose guard refuses every state past `refuse_after` (s); time scale 1 s.
@@ -385,40 +384,129 @@ mod tests {
         }
     }
 
-    /// A fixed step that fails a guard fails at once, the state unchanged: never shortened.
-    #[test]
-    fn a_fixed_step_is_never_shortened() {
-        let steppers: [Box<dyn Stepper>; 2] = [
-            Box::new(Dopri5::fixed_step(0.1)),
-            Box::new(Rosenbrock::fixed_step(0.1)),
-        ];
-        for mut st in steppers {
-            let mut y = [1.0];
-            let mut stats = Stats::default();
-            let mut sys = Decay { refuse_after: 0.0 };
-            let failure = st.step(&mut sys, 0.0, &mut y, 1.0, &mut stats);
-            assert_eq!(failure.unwrap_err().time, 0.1);
-            assert_eq!(y, [1.0]);
-            assert_eq!((stats.rejected_by_guard, stats.steps), (1, 0));
+    /// Euler steps of dy/dt = −y whose error norm is always `err`.
+    struct Stub {
+        control: Controller,
+        err: f64,
+        y_new: Vec<f64>,
+    }
+
+    impl Stub {
+        fn new(control: Controller, err: f64) -> Self {
+            Stub {
+                control,
+                err,
+                y_new: vec![0.0],
+            }
         }
     }
 
-    /// A guard that gives up leaves the next step at the last one tried, for every stepper.
+    impl Adaptive for Stub {
+        fn controller(&mut self) -> &mut Controller {
+            &mut self.control
+        }
+        fn prepare(
+            &mut self,
+            _sys: &mut dyn OdeSystem,
+            _t: f64,
+            _y: &[f64],
+            _stats: &mut Stats,
+        ) -> Result<(), StepFailure> {
+            Ok(())
+        }
+        fn initial_step(
+            &mut self,
+            _sys: &mut dyn OdeSystem,
+            _t: f64,
+            _y: &[f64],
+            _t_end: f64,
+            _stats: &mut Stats,
+        ) -> f64 {
+            0.1
+        }
+        fn attempt(
+            &mut self,
+            _sys: &mut dyn OdeSystem,
+            _t: f64,
+            y: &[f64],
+            h: f64,
+            _stats: &mut Stats,
+        ) -> Attempt {
+            self.y_new[0] = y[0] * (1.0 - h);
+            Attempt::of_norm(self.err)
+        }
+        fn candidate(&mut self) -> &mut [f64] {
+            &mut self.y_new
+        }
+    }
+
+    /// A fixed step that fails a guard fails at once, the state unchanged: never shortened;
+    /// and a fixed step is accepted whatever its error norm.
     #[test]
-    fn a_guard_giving_up_keeps_the_last_step_tried() {
-        let mut d = Dopri5::new(1e-6);
-        let mut r = Rosenbrock::new(1e-6);
-        let steppers: [&mut dyn Adaptive; 2] = [&mut d, &mut r];
-        for st in steppers {
+    fn a_fixed_step_is_never_shortened() {
+        for rule in [StepRule::pi(), StepRule::Elementary] {
+            let mut st = Stub::new(Controller::fixed(rule, 0.1), 1e3);
             let mut y = [1.0];
             let mut stats = Stats::default();
             let mut sys = Decay { refuse_after: 0.0 };
-            assert!(step(st, &mut sys, 0.0, &mut y, 1.0, &mut stats).is_err());
-            let h = st.controller().h.expect("a step was kept");
+            let failure = step(&mut st, &mut sys, 0.0, &mut y, 1.0, &mut stats);
+            assert_eq!(failure.unwrap_err().time, 0.1);
+            assert_eq!(y, [1.0]);
+            assert_eq!((stats.rejected_by_guard, stats.steps), (1, 0));
+            let mut sys = Decay { refuse_after: 1.0 };
+            assert_eq!(
+                step(&mut st, &mut sys, 0.0, &mut y, 1.0, &mut stats),
+                Ok(0.1)
+            );
+            assert_eq!(y, [0.9]);
+        }
+    }
+
+    /// A guard that gives up leaves the next step at the last one tried, whatever the rule.
+    #[test]
+    fn a_guard_giving_up_keeps_the_last_step_tried() {
+        for rule in [StepRule::pi(), StepRule::Elementary] {
+            let mut st = Stub::new(Controller::adaptive(rule), 0.5);
+            let mut y = [1.0];
+            let mut stats = Stats::default();
+            let mut sys = Decay { refuse_after: 0.0 };
+            assert!(step(&mut st, &mut sys, 0.0, &mut y, 1.0, &mut stats).is_err());
+            let h = st.control.h.expect("a step was kept");
             // The last step tried is the first whose quarter falls below the floor (1e-12 s).
             assert!((1e-12..4e-12).contains(&h), "{h:e}");
             assert_eq!(stats.rejected, stats.rejected_by_guard);
+            assert_eq!(y, [1.0]);
         }
+    }
+
+    /// An error norm that never meets the tolerance fails after MAX_REJECTS attempts, or once
+    /// the step falls below the floor.
+    #[test]
+    fn a_tolerance_never_met_fails() {
+        let mut st = Stub::new(Controller::adaptive(StepRule::Elementary), 1.5);
+        let mut stats = Stats::default();
+        let f = step(
+            &mut st,
+            &mut Decay { refuse_after: 9.0 },
+            0.0,
+            &mut [1.0],
+            1.0,
+            &mut stats,
+        );
+        let cause = f.unwrap_err().problem.cause;
+        assert!(cause.contains("after 60 step reductions"), "{cause}");
+        assert_eq!(stats.rejected, u64::from(MAX_REJECTS));
+        let mut st = Stub::new(Controller::adaptive(StepRule::pi()), f64::NAN);
+        let f = step(
+            &mut st,
+            &mut Decay { refuse_after: 9.0 },
+            0.0,
+            &mut [1.0],
+            1.0,
+            &mut stats,
+        );
+        let cause = f.unwrap_err().problem.cause;
+        assert!(cause.contains("the step fell to"), "{cause}");
     }
 
     /// The rules' arithmetic: the PI rule does not grow a step right after a rejection; the

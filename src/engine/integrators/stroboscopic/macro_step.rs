@@ -2,8 +2,7 @@
 //! Heun's method; stage states extrapolated with their fast variables set by their rates on the
 //! slow manifold; the error norm relative to the change the step makes.
 
-use super::samples::Slope;
-use super::stepper::Stroboscopic;
+use super::stepper::{Slope, Stroboscopic};
 use crate::engine::integrators::dopri5::{A, E};
 use crate::engine::integrators::system::{check_state, OdeSystem, Stats};
 

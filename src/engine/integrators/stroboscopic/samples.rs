@@ -1,7 +1,7 @@
 //! The slopes of the averaged flow from stroboscopic points: the derivative at 0 of the
 //! polynomial through them.
 
-use super::stepper::Stroboscopic;
+use super::stepper::{Slope, Stroboscopic};
 use crate::engine::integrators::system::{OdeSystem, Stats, StepFailure};
 
 /// Highest degree of a slope's interpolating polynomial (samples a slope may take).
@@ -9,9 +9,6 @@ pub const MAX_DEGREE: usize = 6;
 
 /// The share of the tolerance a slope's own error may take (in the macro error norm).
 const SLOPE_ERROR_SHARE: f64 = 0.1;
-
-/// A slope of the averaged flow and the rates of the fast variables on the slow manifold.
-pub(super) type Slope = (Vec<f64>, Vec<f64>);
 
 /// Stroboscopic points Ψ¹(y), Ψ²(y), … of a state y, kept as differences from y (their sums
 /// then cancel no large positions), with their fast variables.

@@ -2,10 +2,12 @@
 //! fallbacks) and the macro step loop with its step size in periods (see the module docs of
 //! [`super`]).
 
-use super::samples::Slope;
 use crate::engine::integrators::system::{
     Interrupt, OdeSystem, Problem, Stats, StepFailure, Stepper,
 };
+
+/// A slope of the averaged flow and the rates of the fast variables on the slow manifold.
+pub(super) type Slope = (Vec<f64>, Vec<f64>);
 
 /// Fewest periods a macro step spans: a step's samples cost 6 × d ≥ 12 periods of microscopic
 /// work, so fewer are integrated directly.

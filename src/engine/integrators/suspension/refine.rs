@@ -3,7 +3,7 @@
 //! others from the coarse step; groups that read none of each other apart, on rayon's threads
 //! when the system allows (see the module docs of [`super`]).
 
-use super::scratch::{Path, Refinement, Rounds};
+use super::scratch::{Path, Refined, Refinement, Rounds};
 use super::stepper::Suspension;
 use crate::engine::integrators::controller::{step_too_small, StepRule};
 use crate::engine::integrators::system::{GroupJacobian, Partitioned};
@@ -14,14 +14,6 @@ pub const PARALLEL_GROUPS: usize = 2;
 
 /// The most steps a refinement may take across one coarse step.
 pub const MAX_SUBSTEPS: u32 = 100_000;
-
-/// A refined group's outcome: its state components, its path across the coarse step and the
-/// steps it took.
-pub(super) struct Refined {
-    pub(super) comps: Vec<usize>,
-    pub(super) path: Path,
-    pub(super) steps: u64,
-}
 
 /// Why a refinement or a subset step stopped.
 #[derive(Debug)]

@@ -1,8 +1,6 @@
 //! What the suspension stepper keeps while it refines a step: the scratch of a refinement (one
 //! per thread), the refined paths, and what the rounds of one coarse step keep for the next.
 
-use super::refine::Refined;
-
 /// A refined group's path across a coarse step: (time from its start, the group's states).
 pub(super) type Path = Vec<(f64, Vec<f64>)>;
 
@@ -78,4 +76,12 @@ impl Clone for Pool {
     fn clone(&self) -> Self {
         Pool::default()
     }
+}
+
+/// A refined group's outcome: its state components, its path across the coarse step and the
+/// steps it took.
+pub(super) struct Refined {
+    pub(super) comps: Vec<usize>,
+    pub(super) path: Path,
+    pub(super) steps: u64,
 }
