@@ -4,7 +4,7 @@
 use super::rk_stages::Tableau;
 use crate::engine::contacts::Contacts;
 use crate::engine::integrators::{IntegratorSpec, DOPRI5_A, DOPRI5_C, DOPRI5_E, METHODS};
-use crate::engine::model::Model;
+use crate::engine::model::DeviceKernel;
 use crate::engine::scene::Scene;
 
 /// How the device steps: uniform steps of `dt`, or adaptive steps at relative tolerance `rtol`.
@@ -19,7 +19,7 @@ pub enum GpuSteps {
 /// Whether the device can run the next run of `s` (its model, options and integrator), or why
 /// not, in words.
 pub fn supports(s: &Scene) -> Result<(), String> {
-    model(s.model())?;
+    model(s)?;
     options(s)?;
     tableau(&s.integrator()).map(|_| ())
 }
@@ -27,18 +27,15 @@ pub fn supports(s: &Scene) -> Result<(), String> {
 /// Whether the integrator alone keeps `s` off the device (its model and options could run
 /// there), so that another integrator is a fix.
 pub fn only_the_integrator_refused(s: &Scene) -> bool {
-    model(s.model()).is_ok() && options(s).is_ok() && tableau(&s.integrator()).is_err()
+    model(s).is_ok() && options(s).is_ok() && tableau(&s.integrator()).is_err()
 }
 
-/// The models with device kernels.
-fn model(model: Model) -> Result<(), String> {
-    match model {
-        Model::Micro | Model::Averaged => Ok(()),
-        Model::Rigid => Err(
-            "the rigid-stroke model runs on the CPU only (its per-swimmer stroke solve has no GPU kernel)"
-                .into(),
-        ),
-    }
+/// Whether the scene's model has device kernels, or who lacks them and why.
+fn model(s: &Scene) -> Result<(), String> {
+    s.swimmer_model()
+        .device_kernel()
+        .map(|_| ())
+        .map_err(|(who, why)| format!("{who} runs on the CPU only ({why})"))
 }
 
 /// The options the device kernels do not have: a periodic box, a wall, external forces, contact
@@ -48,14 +45,20 @@ fn options(s: &Scene) -> Result<(), String> {
     if let Some(what) = s.geometry().off_device() {
         return cpu_only(what);
     }
-    match s.model() {
-        _ if !s.external().is_none() => cpu_only("external forces and gravity"),
-        _ if s.thermal().is_on() => cpu_only("thermal noise (temperature above 0)"),
-        _ if s.contacts() != Contacts::default() => {
-            cpu_only("contact handling (overlaps allowed, steric repulsion)")
-        }
-        Model::Averaged if s.cutoff().is_some() => cpu_only("the far-field cutoff"),
-        _ => Ok(()),
+    let averaged = matches!(
+        s.swimmer_model().device_kernel(),
+        Ok(DeviceKernel::Averaged)
+    );
+    if !s.external().is_none() {
+        cpu_only("external forces and gravity")
+    } else if s.thermal().is_on() {
+        cpu_only("thermal noise (temperature above 0)")
+    } else if s.contacts() != Contacts::default() {
+        cpu_only("contact handling (overlaps allowed, steric repulsion)")
+    } else if averaged && s.cutoff().is_some() {
+        cpu_only("the far-field cutoff")
+    } else {
+        Ok(())
     }
 }
 
