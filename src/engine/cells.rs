@@ -133,11 +133,6 @@ pub struct CellGrid {
 }
 
 impl CellGrid {
-    /// Bin the points (x[i], y[i], z[i]) into cells of side `size` (m, positive and finite).
-    pub fn build(x: &[f64], y: &[f64], z: &[f64], size: f64) -> Self {
-        Self::build_in(x, y, z, size, None)
-    }
-
     /// [`CellGrid::build`] in periodic box `periodic`, if any.
     pub fn build_in(
         x: &[f64],

@@ -30,11 +30,6 @@ impl Fft3 {
         Fft3 { m, plans }
     }
 
-    /// Points per axis.
-    pub fn grid(&self) -> [usize; 3] {
-        self.m
-    }
-
     /// Forward transform of `grid` (x fastest) in place, into z fastest, then y, then x; `spare`
     /// is scratch of the same length.
     pub fn forward(&self, grid: &mut [Complex64], spare: &mut [Complex64]) {

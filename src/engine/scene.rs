@@ -41,12 +41,8 @@ mod timing;
 pub use super::boundary::MAX_EXTENT_IN_RADII;
 pub use super::model::DEFAULT_MU;
 use placement::check_center;
-pub use save::{MAX_TIME_IN_PERIODS, SAVE_FORMAT};
-pub use timing::{
-    DEFAULT_AUTO_TOL, DEFAULT_AVERAGED_RTOL, DEFAULT_MICRO_MAX_STEP_PER_PERIOD,
-    DEFAULT_MICRO_STEP_TIMES_RATE, DEFAULT_NOISY_STEP_TIMES_RATE, DEFAULT_RIGID_RTOL,
-    DEFAULT_SUSPENSION_TOL, MAX_COMMON_PERIODS, MAX_PERIOD_DENOMINATOR, SUSPENSION_SWIMMERS,
-};
+pub use save::MAX_TIME_IN_PERIODS;
+pub use timing::{DEFAULT_AUTO_TOL, SUSPENSION_SWIMMERS};
 
 /// The swimmers, the fluid and the numerics of one simulation.
 ///

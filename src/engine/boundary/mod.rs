@@ -23,5 +23,4 @@ mod wall;
 
 pub use geometry::{Extent, Geometry, MobilitySettings, MAX_EXTENT_IN_RADII};
 pub use kinds::{Boundary, Kind};
-pub use open::OpenFluid;
 pub use periodic::ewald;

@@ -1,13 +1,9 @@
 //! The strokes' periods (one, common, shortest), the stiffest spring's rate, and the integrator a
 //! scene takes: the one set, or the model's default for these swimmers (each model's, by the
-//! integrator policy's constants, re-exported here).
+//! integrator policy's constants in `integrators::policy`).
 
 use super::*;
-pub use crate::engine::integrators::{
-    DEFAULT_AUTO_TOL, DEFAULT_AVERAGED_RTOL, DEFAULT_MICRO_MAX_STEP_PER_PERIOD,
-    DEFAULT_MICRO_STEP_TIMES_RATE, DEFAULT_NOISY_STEP_TIMES_RATE, DEFAULT_RIGID_RTOL,
-    DEFAULT_SUSPENSION_TOL,
-};
+pub use crate::engine::integrators::DEFAULT_AUTO_TOL;
 
 /// The largest denominator q of a ratio ωᵢ/ω₀ = p/q that [`Scene::common_period`] recognises.
 pub const MAX_PERIOD_DENOMINATOR: u64 = 64;
