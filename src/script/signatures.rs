@@ -47,11 +47,13 @@ static VOCABULARY: OnceLock<Vocabulary> = OnceLock::new();
 
 /// The vocabulary of [`super::engine()`] (what it registers besides the forms of
 /// `wrong_calls`, which are built from this), installed by the engine builder before any
-/// script runs.
+/// script runs. Before any engine is built it is empty: messages then lack suggestions, and
+/// nothing panics.
 pub fn vocabulary() -> &'static Vocabulary {
+    static EMPTY: OnceLock<Vocabulary> = OnceLock::new();
     VOCABULARY
         .get()
-        .expect("the engine builder installs the vocabulary before any script runs")
+        .unwrap_or_else(|| EMPTY.get_or_init(Vocabulary::default))
 }
 
 /// Reads the vocabulary from `engine`'s metadata, once per process: the engine builder hands in

@@ -8,7 +8,8 @@
 
 use super::arrays::{SlotConst, Soa};
 use super::lanes::{side, Acc};
-use super::{AveragedSystem, CutoffSwitch};
+use super::system::AveragedSystem;
+use super::terms::CutoffSwitch;
 use crate::engine::neighbours::NeighbourList;
 use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
 use nalgebra::Vector3;

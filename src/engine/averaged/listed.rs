@@ -2,13 +2,13 @@
 //! centres move (rebuilt once a centre has moved half the skin), their slot arrays refilled at
 //! every right-hand side, and the steric forces and the contact guard through their near rows.
 
-use super::arrays::SlotConst;
+use super::arrays::{SlotConst, Soa};
 use super::list_rows;
-use super::{
-    pair_weight, AveragedSystem, Problem, Soa, DEFAULT_SKIN_OF_CUTOFF, LIST_SWIMMERS,
-    PARALLEL_SWIMMERS, STATE_PER_SWIMMER,
-};
+use super::system::{AveragedSystem, DEFAULT_SKIN_OF_CUTOFF, LIST_SWIMMERS, PARALLEL_SWIMMERS};
+use super::terms::pair_weight;
 use crate::engine::contacts::Steric;
+use crate::engine::integrators::Problem;
+use crate::engine::model::STATE_PER_SWIMMER;
 use crate::engine::neighbours::{ListSpec, NeighbourList};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -347,7 +347,7 @@ impl AveragedSystem {
             rows.clone().filter_map(shared).min()
         };
         if let Some((s, r)) = found {
-            return Err(super::shared_centre_problem(s, r));
+            return Err(super::ode::shared_centre_problem(s, r));
         }
         if self.contacts.allow_overlap {
             return Ok(());

@@ -38,10 +38,3 @@ pub use system::{
 };
 pub(crate) use terms::pair_constants;
 pub use terms::{CutoffSwitch, CUTOFF_SWITCH_WIDTH};
-
-// The names `listed` and `list_rows` read from here.
-use crate::engine::integrators::Problem;
-use crate::engine::model::STATE_PER_SWIMMER;
-use arrays::Soa;
-use ode::shared_centre_problem;
-use terms::pair_weight;
