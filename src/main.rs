@@ -127,6 +127,7 @@ impl From<BenchKind> for swimlab::bench::report::Kind {
             BenchKind::Pairs => Kind::Pairs,
             BenchKind::Scaling => Kind::Scaling,
             BenchKind::Ewald => Kind::Ewald,
+            BenchKind::Boundaries => Kind::Boundaries,
             BenchKind::Suspension => Kind::Suspension,
         }
     }
@@ -154,6 +155,10 @@ enum BenchKind {
     /// 15,625 spheres (--quick: up to 512; Beenakker up to 4,096), with open space for scale, the
     /// methods' difference against the tolerance and the crossover "auto" uses.
     Ewald,
+    /// One right-hand side of a suspension at volume fraction 1% in a periodic box and above a
+    /// wall against the same swimmers in open space, microscopic and rigid-stroke models, 100 and
+    /// 1,000 swimmers (--quick: 100), side by side.
+    Boundaries,
     /// Bulk suspensions of the averaged model (~15 min; --quick: ~1 min): one right-hand side of
     /// 10,000 swimmers in a box with a cutoff against 1,024 all pairs, side by side; add_random of
     /// 100,000; suspension(tol)'s error against RK4 and its order; runs of 1,000 and 10,000

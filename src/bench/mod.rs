@@ -2,6 +2,7 @@
 //! the engine only and measure on the machine at hand; figures are reported, never asserted.
 
 pub mod backends;
+pub mod boundaries;
 pub mod ewald;
 pub mod pairs;
 pub mod plots;

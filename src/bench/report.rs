@@ -1,7 +1,9 @@
 //! `swimlab bench ...`: each benchmark's tables printed and written as CSV, with its pictures,
 //! under out/bench/. The command line only names the benchmark.
 
-use super::{backends, ewald, pairs, plots, scaling, stability, suspension, work_precision};
+use super::{
+    backends, boundaries, ewald, pairs, plots, scaling, stability, suspension, work_precision,
+};
 use crate::engine::Model;
 
 /// The benchmarks `swimlab bench` runs.
@@ -19,6 +21,8 @@ pub enum Kind {
     Scaling,
     /// The periodic box's mobility product by both Ewald methods against size.
     Ewald,
+    /// One right-hand side in a box and above a wall against open space.
+    Boundaries,
     /// Bulk suspensions of the averaged model: right-hand side, placement, long runs, accuracy.
     Suspension,
 }
@@ -115,6 +119,20 @@ pub fn run(
             t.write_csv(std::path::Path::new("out/bench/ewald.csv"))
                 .map_err(io)?;
             say("\nCSV written to out/bench/ewald.csv")?;
+        }
+        Kind::Boundaries => {
+            let sizes: &[usize] = if quick { &[100] } else { &[100, 1000] };
+            let rows = boundaries::run(sizes)?;
+            let t = boundaries::table(&rows);
+            say(&format!(
+                "one right-hand side, random Fig-1 swimmers at sphere volume fraction {}, the same state in open space, a periodic box and above a wall ({} threads; medians):\n{}",
+                boundaries::PHI,
+                rayon::current_num_threads(),
+                t.render()
+            ))?;
+            t.write_csv(std::path::Path::new("out/bench/boundaries.csv"))
+                .map_err(io)?;
+            say("\nCSV written to out/bench/boundaries.csv")?;
         }
         Kind::Scaling => {
             let rows = scaling::run(if quick { 256 } else { 4096 })?;

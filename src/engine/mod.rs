@@ -44,6 +44,7 @@ mod spheres;
 pub(crate) mod stepping;
 pub mod structure;
 pub mod swimmer;
+pub mod tensions;
 pub mod thermal;
 pub(crate) mod trajectory;
 mod vtk;

@@ -11,11 +11,14 @@
 //! Then, as in the spring model, dR_H/dt = (a1 u₁ + a2 u₂)/(a1+a2) (the drag parts cancel exactly)
 //! and dN/dt = (I − NNᵀ)(u₂ − u₁)/L, u the interaction velocities. Nothing is stiff any more: the
 //! step is set by the stroke, not by the spring.
+//!
+//! A = −K with K = BᵀMB symmetric positive definite; how it is solved (elimination, or conjugate
+//! gradients on a matrix or over mobility products, by boundary and size) is
+//! [`super::tensions`].
 
 use super::boundary::Boundary;
 use super::contacts::Contacts;
 use super::error::{self, unsupported, EngineError, Setting};
-use super::ewald::EwaldMethod;
 use super::integrators::{
     IntegratorSpec, OdeSystem, Problem, Reach, DEFAULT_AUTO_TOL, DEFAULT_RIGID_RTOL,
 };
@@ -25,7 +28,8 @@ use super::model::{
 };
 use super::spheres::Spheres;
 use super::swimmer::{shortest_period, Dumbbell};
-use nalgebra::{DMatrix, DVector, Vector3};
+use super::tensions::Tensions;
+use nalgebra::{DVector, Vector3};
 
 /// The rigid-stroke right-hand side with its scratch buffers.
 #[derive(Debug, Clone)]
@@ -33,8 +37,12 @@ pub struct RigidSystem {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
     spheres: Spheres,
-    a: DMatrix<f64>,
+    /// The constraint solve, its scratch and last tensions.
+    tensions: Tensions,
+    /// The stroke rates less the body forces' part, then the tensions.
     rate: DVector<f64>,
+    /// The orientations of the last placement.
+    n: Vec<Vector3<f64>>,
     /// Scratch: the sphere velocities of the body forces alone.
     body: Vec<Vector3<f64>>,
     /// How far the centres may go (unbounded until set).
@@ -62,8 +70,9 @@ impl RigidSystem {
             swimmers: swimmers.to_vec(),
             base: base.to_vec(),
             spheres: Spheres::new(swimmers, mu, mobility, contacts),
-            a: DMatrix::zeros(s, s),
+            tensions: Tensions::new(&Boundary::Open, s),
             rate: DVector::zeros(s),
+            n: vec![Vector3::zeros(); s],
             body: Vec::new(),
             reach: Reach::default(),
         }
@@ -84,11 +93,6 @@ impl RigidSystem {
         }
     }
 
-    /// H_αβ v for spheres α, β (self term when α = β).
-    fn h(&self, alpha: usize, beta: usize, v: &Vector3<f64>) -> Vector3<f64> {
-        self.spheres.block_apply(alpha, beta, v)
-    }
-
     /// The constant external force on every sphere (N; none when empty).
     pub fn set_external(&mut self, external: Vec<Vector3<f64>>) {
         self.spheres.set_external(external);
@@ -100,6 +104,7 @@ impl RigidSystem {
         boundary: Boundary,
         operator: Box<dyn crate::engine::mobility::MobilityOperator>,
     ) {
+        self.tensions = Tensions::new(&boundary, self.swimmers.len());
         self.spheres.set_boundary(boundary, operator);
     }
 
@@ -112,31 +117,31 @@ impl RigidSystem {
 
     /// Fill `self.rate` with the tensions (solving A T = L̇).
     fn solve(&mut self, t: f64, y: &[f64]) {
-        let s_count = self.swimmers.len();
-        let n: Vec<Vector3<f64>> = (0..s_count)
-            .map(|s| vec3(y, STATE_PER_SWIMMER * s + 3))
-            .collect();
-        for sg in 0..s_count {
-            for tau in 0..s_count {
-                let (i1, i2, j1, j2) = (2 * sg, 2 * sg + 1, 2 * tau, 2 * tau + 1);
-                let nt = n[tau];
-                let rel = (self.h(i2, j1, &nt) - self.h(i1, j1, &nt))
-                    - (self.h(i2, j2, &nt) - self.h(i1, j2, &nt));
-                self.a[(sg, tau)] = n[sg].dot(&rel);
-            }
-            let d = &self.swimmers[sg];
+        for (s, n) in self.n.iter_mut().enumerate() {
+            *n = vec3(y, STATE_PER_SWIMMER * s + 3);
+        }
+        for (sg, d) in self.swimmers.iter().enumerate() {
             self.rate[sg] = d.lambda * d.omega * (d.omega * t + d.phase).cos();
         }
         // Body forces (a wall's repulsion, external forces) move the spheres too: the tensions
         // make up what their velocities leave of L̇.
         if self.spheres.body_velocities(&mut self.body) {
-            for (sg, ns) in n.iter().enumerate() {
+            for (sg, ns) in self.n.iter().enumerate() {
                 self.rate[sg] -= ns.dot(&(self.body[2 * sg + 1] - self.body[2 * sg]));
             }
         }
-        if !solve_in_place(&mut self.a, &mut self.rate) {
-            self.rate.fill(f64::NAN);
-        }
+        self.tensions.solve(
+            &mut self.spheres,
+            &self.swimmers,
+            &self.n,
+            t,
+            &mut self.rate,
+        );
+    }
+
+    /// The tension solve's route and the mobility products its last solve took.
+    pub fn tension_solver(&self) -> &Tensions {
+        &self.tensions
     }
 }
 
@@ -202,40 +207,6 @@ impl OdeSystem for RigidSystem {
     }
 }
 
-/// Solve A x = b in place (x overwrites b) by Gaussian elimination with partial pivoting, without
-/// allocating: this runs in every right-hand side. A is diagonally dominant here (drag ≫
-/// interaction for non-overlapping spheres). Returns false if A is singular.
-fn solve_in_place(a: &mut DMatrix<f64>, b: &mut DVector<f64>) -> bool {
-    let n = b.len();
-    for col in 0..n {
-        let pivot = (col..n)
-            .max_by(|&i, &j| a[(i, col)].abs().total_cmp(&a[(j, col)].abs()))
-            .unwrap_or(col);
-        if a[(pivot, col)] == 0.0 || !a[(pivot, col)].is_finite() {
-            return false;
-        }
-        if pivot != col {
-            a.swap_rows(pivot, col);
-            b.swap_rows(pivot, col);
-        }
-        for row in (col + 1)..n {
-            let f = a[(row, col)] / a[(col, col)];
-            for k in col..n {
-                a[(row, k)] -= f * a[(col, k)];
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    for row in (0..n).rev() {
-        let mut acc = b[row];
-        for k in (row + 1)..n {
-            acc -= a[(row, k)] * b[k];
-        }
-        b[row] = acc / a[(row, row)];
-    }
-    true
-}
-
 /// The rigid-stroke model's answers to the model seam: its state holds the unit orientation N,
 /// its constraint solve takes blocks (Beenakker's sums in a box) and dumbbell tensions only, and
 /// it runs on the CPU.
@@ -252,11 +223,9 @@ fn rigid_system(s: &dyn SceneView) -> error::Result<RigidSystem> {
         s.mobility(),
         s.contacts().allow_overlap,
     );
-    // The constraint solve takes blocks, which are Beenakker's sums.
-    sys.set_boundary(
-        *s.boundary(),
-        s.mobility_operator_by(EwaldMethod::Beenakker)?,
-    );
+    // Products by the scene's Ewald method; blocks (a few swimmers' elimination) are
+    // Beenakker's sums whatever it is.
+    sys.set_boundary(*s.boundary(), s.mobility_operator_by(s.ewald_method())?);
     sys.set_external(s.sphere_forces());
     sys.set_reach(s.reach());
     Ok(sys)
@@ -280,10 +249,6 @@ impl SwimmerModel for RigidStrokes {
     /// The constraint tension of the S×S solve.
     fn tension(&self, s: &dyn SceneView, i: usize) -> error::Result<f64> {
         Ok(rigid_system(s)?.tensions(s.time(), s.state())[i])
-    }
-
-    fn ewald_method(&self, _set: EwaldMethod) -> Option<EwaldMethod> {
-        Some(EwaldMethod::Beenakker)
     }
 
     fn default_integrator(&self, _s: &dyn SceneView) -> IntegratorSpec {
@@ -319,19 +284,5 @@ impl SwimmerModel for RigidStrokes {
             "the rigid-stroke model",
             "its per-swimmer stroke solve has no GPU kernel",
         ))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn elimination_solves_a_pivoting_system() {
-        let mut a = DMatrix::from_row_slice(3, 3, &[0.0, 2.0, 1.0, 1.0, 1.0, 1.0, 2.0, 1.0, 3.0]);
-        let x = DVector::from_vec(vec![1.0, -2.0, 0.5]);
-        let mut b = &a * &x;
-        assert!(solve_in_place(&mut a, &mut b));
-        assert!((b - x).amax() < 1e-14);
     }
 }

@@ -1,0 +1,137 @@
+//! One right-hand side of a suspension in each boundary against the same swimmers in open space:
+//! the microscopic (spring) and rigid-stroke models, side by side in one process.
+//!
+//! Each size is `S` asymmetric Fig-1 swimmers (a2 = a1/2) placed at random at sphere volume fraction φ = 1% in a cube
+//! ([`crate::engine::build::box_side`]); the same state is then evaluated in open space, in the
+//! periodic box of that side, and above a wall just below the cube. The times are medians of
+//! right-hand sides repeated until each series has run ~0.3 s (at least 3), the system built once
+//! (as a run builds it once) and the time advanced by a fortieth of a period between them (as a
+//! run's stages advance; the rigid model's iteration starts from the last tensions).
+
+use super::table::Table;
+use crate::engine::build::{box_side, random_suspension, Orientations, Phases};
+use crate::engine::wall::Wall;
+use crate::engine::{Dumbbell, Model, Scene};
+use std::time::Instant;
+
+/// The sphere volume fraction of every scene.
+pub const PHI: f64 = 0.01;
+
+/// One model at one size.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// The model.
+    pub model: Model,
+    /// Swimmers.
+    pub swimmers: usize,
+    /// Seconds per right-hand side in open space.
+    pub open: f64,
+    /// In the periodic box.
+    pub periodic: f64,
+    /// Above the wall.
+    pub wall: f64,
+}
+
+/// Median seconds of one right-hand side of `scene` as it is.
+fn rhs_time(scene: &Scene) -> Result<f64, String> {
+    let mut sys = scene.system().map_err(|e| e.to_string())?;
+    let (y, _) = scene.raw_state();
+    let y = y.to_vec();
+    let mut dy = vec![0.0; y.len()];
+    let h = scene.period().map_err(|e| e.to_string())? / 40.0;
+    let mut t = scene.time();
+    let mut times = Vec::new();
+    let start = Instant::now();
+    while times.len() < 3 || (start.elapsed().as_secs_f64() < 0.3 && times.len() < 50) {
+        t += h;
+        let s = Instant::now();
+        sys.rhs(t, &y, &mut dy);
+        times.push(s.elapsed().as_secs_f64());
+    }
+    if dy.iter().any(|v| !v.is_finite()) {
+        return Err("a right-hand side was not finite".into());
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times[times.len() / 2])
+}
+
+/// `swimmers` random Fig-1 swimmers at φ = 1% under `model`, in open space, a box and above a
+/// wall.
+pub fn measure(model: Model, swimmers: usize, seed: u64) -> Result<Row, String> {
+    let err = |e: crate::engine::EngineError| e.to_string();
+    // The paper's asymmetric swimmer: a2 = a1/2, a1 = 1.5 Λ with Λ = 0.15 ℓ.
+    let mut d = Dumbbell::default();
+    (d.a1, d.a2) = (0.225 * d.ell, 0.1125 * d.ell);
+    let side = box_side(swimmers, &d, PHI).map_err(err)?;
+    let mut scene = Scene::new();
+    scene.set_model(model);
+    scene.set_box(Some([side; 3])).map_err(err)?;
+    random_suspension(
+        &mut scene,
+        swimmers,
+        d,
+        [side; 3],
+        Orientations::Random,
+        Phases::Random,
+        seed,
+    )
+    .map_err(err)?;
+    let periodic = rhs_time(&scene)?;
+    scene.set_box(None).map_err(err)?;
+    let open = rhs_time(&scene)?;
+    let reach = d.ell + d.lambda + d.a1.max(d.a2);
+    scene
+        .set_wall(Some(Wall::at(-0.5 * side - reach).map_err(err)?))
+        .map_err(err)?;
+    let wall = rhs_time(&scene)?;
+    Ok(Row {
+        model,
+        swimmers,
+        open,
+        periodic,
+        wall,
+    })
+}
+
+/// The microscopic and rigid-stroke models at every size in `sizes`.
+pub fn run(sizes: &[usize]) -> Result<Vec<Row>, String> {
+    let mut rows = Vec::new();
+    for &s in sizes {
+        for model in [Model::Micro, Model::Rigid] {
+            rows.push(measure(model, s, 0x5eed + s as u64)?);
+        }
+    }
+    Ok(rows)
+}
+
+/// The table: seconds per right-hand side in each boundary, the ratios to open space, and the
+/// rigid model's open-space time over the spring model's at the same size.
+pub fn table(rows: &[Row]) -> Table {
+    let mut t = Table::new(&[
+        "model",
+        "swimmers",
+        "open_s",
+        "box_s",
+        "wall_s",
+        "box_over_open",
+        "wall_over_open",
+        "open_over_micro_open",
+    ]);
+    for r in rows {
+        let micro = rows
+            .iter()
+            .find(|m| m.model == Model::Micro && m.swimmers == r.swimmers)
+            .map_or(f64::NAN, |m| m.open);
+        t.rows.push(vec![
+            r.model.name().to_string(),
+            r.swimmers.to_string(),
+            format!("{:.3e}", r.open),
+            format!("{:.3e}", r.periodic),
+            format!("{:.3e}", r.wall),
+            format!("{:.2}", r.periodic / r.open),
+            format!("{:.2}", r.wall / r.open),
+            format!("{:.2}", r.open / micro),
+        ]);
+    }
+    t
+}

@@ -1,0 +1,547 @@
+//! The rigid-stroke model's constraint tensions: the S×S system K T = −L̇' of its dumbbells, solved
+//! at every right-hand side.
+//!
+//! With tension T_τ on dumbbell τ (force +T N on sphere 1, −T N on sphere 2), B T the sphere
+//! forces and M the mobility, K = BᵀMB: K_στ = N_σ·(H_{1σ,1τ} − H_{1σ,2τ} − H_{2σ,1τ} + H_{2σ,2τ})N_τ,
+//! symmetric positive definite wherever M is. The right side L̇' is each stroke's length rate less
+//! what the body forces' velocities already give it.
+//!
+//! How K is met depends on what a block costs ([`Route`]):
+//! - a few swimmers outside a box: K from the boundary's blocks, Gaussian elimination;
+//! - open space: K from the pair coefficients, contracted with the orientations as it is filled
+//!   (O(S²), the cost of about one mobility product), then conjugate gradients on the matrix;
+//! - a wall: K from the wall's blocks, then conjugate gradients on the matrix;
+//! - a periodic box (whose blocks are whole Ewald sums) and beyond [`DENSE_MATRIX_UP_TO`]
+//!   swimmers: conjugate gradients over mobility products (K T is one product), no matrix at all.
+//!
+//! The iteration is preconditioned by each dumbbell's own K_σσ in open space and starts from the
+//! last solve's tensions; where it stalls, the blocks and elimination take over. No route has an
+//! S³ term but the elimination of a few swimmers and that fallback.
+
+use super::boundary::Boundary;
+use super::mobility::self_mobility;
+use super::parallel::PARALLEL_SPHERES;
+use super::simd::vector_dispatch;
+use super::spheres::Spheres;
+use super::swimmer::Dumbbell;
+use nalgebra::{DMatrix, DVector, Vector3};
+use rayon::prelude::*;
+
+/// Up to this many swimmers outside a periodic box the tensions are eliminated densely: 4S²
+/// blocks cost less there than filling K and iterating.
+pub const ELIMINATE_UP_TO: usize = 8;
+
+/// Up to this many swimmers outside a box K is held as a matrix (8 S² bytes: 32 MB at 2,048);
+/// beyond, the iteration takes mobility products.
+pub const DENSE_MATRIX_UP_TO: usize = 2048;
+
+/// The iteration stops when the residual of K T = −L̇' is this fraction of |L̇'|: far below any
+/// integrator tolerance the tensions feed (a relative tension error ε moves a centre by about ε
+/// times its stroke-scale oscillation, 1e-6 of which is the drift per period), and ~1e4 times
+/// the rounding of one product.
+pub const TENSION_RTOL: f64 = 1e-12;
+
+/// Iterations before the elimination takes over (CG ends in S in exact arithmetic; at the
+/// densities the model holds it takes tens).
+const MAX_ITERATIONS: usize = 500;
+
+/// How K is met.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Route {
+    /// From blocks, eliminated.
+    Eliminate,
+    /// Filled from open space's pair coefficients, iterated on the matrix.
+    OpenPairs,
+    /// Filled from the boundary's blocks, iterated on the matrix.
+    Blocks,
+    /// Iterated over mobility products.
+    Products,
+}
+
+impl Route {
+    /// The route for `swimmers` dumbbells in `boundary`.
+    pub fn for_scene(boundary: &Boundary, swimmers: usize) -> Self {
+        match boundary {
+            Boundary::Periodic(_) => Route::Products,
+            _ if swimmers <= ELIMINATE_UP_TO => Route::Eliminate,
+            _ if swimmers > DENSE_MATRIX_UP_TO => Route::Products,
+            Boundary::Open => Route::OpenPairs,
+            Boundary::Wall(_) => Route::Blocks,
+        }
+    }
+}
+
+/// The solver with its scratch and the last tensions.
+#[derive(Debug, Clone)]
+pub struct Tensions {
+    route: Route,
+    k: DMatrix<f64>,
+    last: Vec<f64>,
+    forces: Vec<f64>,
+    velocities: Vec<f64>,
+    diag: Vec<f64>,
+    r: DVector<f64>,
+    z: DVector<f64>,
+    p: DVector<f64>,
+    q: DVector<f64>,
+    products: usize,
+}
+
+impl Tensions {
+    /// A solver for `swimmers` dumbbells in `boundary`.
+    pub fn new(boundary: &Boundary, swimmers: usize) -> Self {
+        Self::by(Route::for_scene(boundary, swimmers), swimmers)
+    }
+
+    /// A solver for `swimmers` dumbbells that takes `route`.
+    pub fn by(route: Route, swimmers: usize) -> Self {
+        let held = route != Route::Products;
+        let zeros = || DVector::zeros(swimmers);
+        Tensions {
+            route,
+            k: if held {
+                DMatrix::zeros(swimmers, swimmers)
+            } else {
+                DMatrix::zeros(0, 0)
+            },
+            last: Vec::new(),
+            forces: vec![0.0; 6 * swimmers],
+            velocities: vec![0.0; 6 * swimmers],
+            diag: vec![0.0; swimmers],
+            r: zeros(),
+            z: zeros(),
+            p: zeros(),
+            q: zeros(),
+            products: 0,
+        }
+    }
+
+    /// The route taken.
+    pub fn route(&self) -> Route {
+        self.route
+    }
+
+    /// Mobility products the last solve took (0 on the matrix routes).
+    pub fn products(&self) -> usize {
+        self.products
+    }
+
+    /// Replace `rate` (L̇' per dumbbell) by the tensions (N), for the spheres placed in `spheres`
+    /// at time `t` with orientations `n`; NaN where K is singular.
+    pub(crate) fn solve(
+        &mut self,
+        spheres: &mut Spheres,
+        swimmers: &[Dumbbell],
+        n: &[Vector3<f64>],
+        t: f64,
+        rate: &mut DVector<f64>,
+    ) {
+        self.products = 0;
+        let solved = match self.route {
+            Route::Eliminate => false,
+            Route::OpenPairs => {
+                fill_open_pairs(spheres, n, &mut self.k);
+                self.iterate(spheres, swimmers, n, t, rate)
+            }
+            Route::Blocks => {
+                fill_blocks(spheres, n, &mut self.k);
+                self.iterate(spheres, swimmers, n, t, rate)
+            }
+            Route::Products => self.iterate(spheres, swimmers, n, t, rate),
+        };
+        if !solved {
+            eliminate(spheres, n, rate);
+            self.last.clear();
+            self.last.extend(rate.iter());
+        }
+    }
+
+    /// q = K p, by the matrix or by one mobility product (forces +p N on sphere 1, −p N on
+    /// sphere 2; then N·(u₁ − u₂) per dumbbell).
+    fn apply(&mut self, spheres: &mut Spheres, n: &[Vector3<f64>]) {
+        if self.route != Route::Products {
+            self.k.mul_to(&self.p, &mut self.q);
+            return;
+        }
+        for (s, ns) in n.iter().enumerate() {
+            let v = self.p[s] * ns;
+            self.forces[6 * s..6 * s + 3].copy_from_slice(v.as_slice());
+            self.forces[6 * s + 3..6 * s + 6].copy_from_slice((-v).as_slice());
+        }
+        spheres.apply_mobility(&self.forces, &mut self.velocities);
+        for (s, ns) in n.iter().enumerate() {
+            let u = &self.velocities[6 * s..6 * s + 6];
+            self.q[s] = ns.dot(&Vector3::new(u[0] - u[3], u[1] - u[4], u[2] - u[5]));
+        }
+        self.products += 1;
+    }
+
+    /// Preconditioned conjugate gradients for K T = −rate from the last tensions; the tensions
+    /// in `rate`. False (rate untouched) if the residual did not fall to [`TENSION_RTOL`].
+    fn iterate(
+        &mut self,
+        spheres: &mut Spheres,
+        swimmers: &[Dumbbell],
+        n: &[Vector3<f64>],
+        t: f64,
+        rate: &mut DVector<f64>,
+    ) -> bool {
+        let count = swimmers.len();
+        let b_norm = rate.norm();
+        if b_norm == 0.0 {
+            self.last.clear();
+            self.last.resize(count, 0.0);
+            return true;
+        }
+        // Jacobi: each dumbbell's own K_σσ in open space, 1/(6πμa1) + 1/(6πμa2) − 2 N·H₁₂N.
+        let (mu, mobility) = (spheres.mu, spheres.mobility);
+        for (s, d) in swimmers.iter().enumerate() {
+            let (ci, crr) = mobility.pair_coefficients(mu, d.rest_length(t), d.a1, d.a2);
+            self.diag[s] = self_mobility(mu, d.a1) + self_mobility(mu, d.a2) - 2.0 * (ci + crr);
+        }
+        let mut x = if self.last.len() == count && self.last.iter().all(|v| v.is_finite()) {
+            DVector::from_column_slice(&self.last)
+        } else {
+            DVector::from_iterator(count, rate.iter().zip(&self.diag).map(|(b, d)| -b / d))
+        };
+        self.p.copy_from(&x);
+        self.apply(spheres, n);
+        for s in 0..count {
+            self.r[s] = -rate[s] - self.q[s];
+            self.z[s] = self.r[s] / self.diag[s];
+        }
+        self.p.copy_from(&self.z);
+        let mut rz = self.r.dot(&self.z);
+        let mut converged = false;
+        for _ in 0..MAX_ITERATIONS.min(count + 50) {
+            if self.r.norm() <= TENSION_RTOL * b_norm {
+                converged = true;
+                break;
+            }
+            self.apply(spheres, n);
+            let pq = self.p.dot(&self.q);
+            if !(pq > 0.0 && rz.is_finite()) {
+                break;
+            }
+            let alpha = rz / pq;
+            x.axpy(alpha, &self.p, 1.0);
+            self.r.axpy(-alpha, &self.q, 1.0);
+            for s in 0..count {
+                self.z[s] = self.r[s] / self.diag[s];
+            }
+            let rz_next = self.r.dot(&self.z);
+            let beta = rz_next / rz;
+            rz = rz_next;
+            self.p.axpy(1.0, &self.z, beta);
+        }
+        if !converged {
+            return false;
+        }
+        rate.copy_from(&x);
+        self.last.clear();
+        self.last.extend(x.iter());
+        true
+    }
+}
+
+/// K_στ from the boundary's blocks: 4 per pair of dumbbells.
+fn k_entry(spheres: &Spheres, n: &[Vector3<f64>], sg: usize, tau: usize) -> f64 {
+    let (i1, i2, j1, j2) = (2 * sg, 2 * sg + 1, 2 * tau, 2 * tau + 1);
+    let nt = n[tau];
+    let h = |a, b| spheres.block_apply(a, b, &nt);
+    n[sg].dot(&((h(i1, j1) - h(i2, j1)) - (h(i1, j2) - h(i2, j2))))
+}
+
+/// K filled from the boundary's blocks.
+fn fill_blocks(spheres: &Spheres, n: &[Vector3<f64>], k: &mut DMatrix<f64>) {
+    let count = n.len();
+    for tau in 0..count {
+        for sg in 0..=tau {
+            let v = k_entry(spheres, n, sg, tau);
+            k[(sg, tau)] = v;
+            k[(tau, sg)] = v;
+        }
+    }
+}
+
+/// The dumbbells as open space's K fill reads them: sphere centres, squared radii and
+/// orientations in lanes, and the constants of the pair tensor.
+struct KLanes {
+    p1: [Vec<f64>; 3],
+    p2: [Vec<f64>; 3],
+    n: [Vec<f64>; 3],
+    q1: Vec<f64>,
+    q2: Vec<f64>,
+    /// 1/(8πμ).
+    c8: f64,
+    /// 1/3 for RPY (its a² term), 0 for Oseen.
+    finite: f64,
+}
+
+/// Column τ of K for every σ by the far-apart pair tensor (c_I = o + f, c_rr = o − 3f with
+/// o = 1/(8πμd), f = (a_i² + a_j²) o/(3d²)), and in `margin` the least d² − (a_i + a_j)² of the
+/// four sphere pairs (≤ 0 where a pair overlaps and the far form does not hold).
+#[inline(always)]
+fn k_column_body(l: &KLanes, tau: usize, col: &mut [f64], margin: &mut [f64]) {
+    let t1 = [l.p1[0][tau], l.p1[1][tau], l.p1[2][tau]];
+    let t2 = [l.p2[0][tau], l.p2[1][tau], l.p2[2][tau]];
+    let nt = [l.n[0][tau], l.n[1][tau], l.n[2][tau]];
+    let (tq1, tq2) = (l.q1[tau], l.q2[tau]);
+    let (c8, finite) = (l.c8, l.finite);
+    for (sg, (entry, least)) in col.iter_mut().zip(margin.iter_mut()).enumerate() {
+        let ns = [l.n[0][sg], l.n[1][sg], l.n[2][sg]];
+        let nn = ns[0] * nt[0] + ns[1] * nt[1] + ns[2] * nt[2];
+        let s1 = [l.p1[0][sg], l.p1[1][sg], l.p1[2][sg]];
+        let s2 = [l.p2[0][sg], l.p2[1][sg], l.p2[2][sg]];
+        let (sq1, sq2) = (l.q1[sg], l.q2[sg]);
+        let term = |a: [f64; 3], qa: f64, b: [f64; 3], qb: f64| {
+            let r = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            let inv_d2 = 1.0 / d2;
+            let o = c8 * inv_d2.sqrt();
+            let f = finite * (qa + qb) * inv_d2 * o;
+            let nsr = ns[0] * r[0] + ns[1] * r[1] + ns[2] * r[2];
+            let ntr = nt[0] * r[0] + nt[1] * r[1] + nt[2] * r[2];
+            let sum = qa.sqrt() + qb.sqrt();
+            (
+                (o + f) * nn + (o - 3.0 * f) * nsr * ntr * inv_d2,
+                d2 - sum * sum,
+            )
+        };
+        let (k11, m11) = term(s1, sq1, t1, tq1);
+        let (k12, m12) = term(s1, sq1, t2, tq2);
+        let (k21, m21) = term(s2, sq2, t1, tq1);
+        let (k22, m22) = term(s2, sq2, t2, tq2);
+        *entry = (k11 - k12) - (k21 - k22);
+        *least = m11.min(m12).min(m21).min(m22);
+    }
+}
+
+vector_dispatch! {
+    /// [`k_column_body`] in the widest vector unit present.
+    fn k_column(l: &KLanes, tau: usize, col: &mut [f64], margin: &mut [f64]) = k_column_body;
+}
+
+/// K filled from open space's pair coefficients, each sphere pair's tensor contracted with the
+/// two orientations as it is made: N_σ·H N_τ = c_I N_σ·N_τ + c_rr (N_σ·r)(N_τ·r)/r². Column by
+/// column in vector lanes (in parallel for many spheres); the diagonal and any entry with
+/// overlapping spheres again by the exact pair coefficients.
+fn fill_open_pairs(spheres: &Spheres, n: &[Vector3<f64>], k: &mut DMatrix<f64>) {
+    let count = n.len();
+    let (mu, mobility) = (spheres.mu, spheres.mobility);
+    let (pos, radii) = (&spheres.pos, &spheres.radii);
+    let lane = |f: &dyn Fn(usize) -> f64| (0..count).map(f).collect::<Vec<f64>>();
+    let lanes = KLanes {
+        p1: [0, 1, 2].map(|c| lane(&|s| pos[2 * s][c])),
+        p2: [0, 1, 2].map(|c| lane(&|s| pos[2 * s + 1][c])),
+        n: [0, 1, 2].map(|c| lane(&|s| n[s][c])),
+        q1: lane(&|s| radii[2 * s] * radii[2 * s]),
+        q2: lane(&|s| radii[2 * s + 1] * radii[2 * s + 1]),
+        c8: 1.0 / (8.0 * std::f64::consts::PI * mu),
+        finite: if mobility == super::mobility::Mobility::Rpy {
+            1.0 / 3.0
+        } else {
+            0.0
+        },
+    };
+    let exact = |sg: usize, tau: usize| {
+        let (ns, nt) = (n[sg], n[tau]);
+        let nn = ns.dot(&nt);
+        let mut sum = 0.0;
+        for (a, sign_a) in [(2 * sg, 1.0), (2 * sg + 1, -1.0)] {
+            for (b, sign_b) in [(2 * tau, 1.0), (2 * tau + 1, -1.0)] {
+                let term = if a == b {
+                    self_mobility(mu, radii[a]) * nn
+                } else {
+                    let r = pos[a] - pos[b];
+                    let d2 = r.norm_squared();
+                    let (ci, crr) = mobility.pair_coefficients(mu, d2.sqrt(), radii[a], radii[b]);
+                    ci * nn + crr * ns.dot(&r) * nt.dot(&r) / d2
+                };
+                sum += sign_a * sign_b * term;
+            }
+        }
+        sum
+    };
+    let column = |tau: usize, col: &mut [f64]| {
+        let mut margin = vec![0.0; count];
+        k_column(&lanes, tau, col, &mut margin);
+        for (sg, (entry, m)) in col.iter_mut().zip(&margin).enumerate() {
+            if sg == tau || m.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                *entry = exact(sg, tau);
+            }
+        }
+    };
+    let data = k.as_mut_slice();
+    if 2 * count >= PARALLEL_SPHERES / 2 {
+        data.par_chunks_mut(count)
+            .enumerate()
+            .for_each(|(tau, col)| column(tau, col));
+    } else {
+        data.chunks_mut(count)
+            .enumerate()
+            .for_each(|(tau, col)| column(tau, col));
+    }
+}
+
+/// The tensions by Gaussian elimination of K (from blocks) against −rate, into `rate`; NaN where
+/// K is singular.
+fn eliminate(spheres: &Spheres, n: &[Vector3<f64>], rate: &mut DVector<f64>) {
+    let count = n.len();
+    let mut k = DMatrix::zeros(count, count);
+    fill_blocks(spheres, n, &mut k);
+    rate.neg_mut();
+    if !solve_in_place(&mut k, rate) {
+        rate.fill(f64::NAN);
+    }
+}
+
+/// Solve A x = b in place (x overwrites b) by Gaussian elimination with partial pivoting.
+/// Returns false if A is singular.
+fn solve_in_place(a: &mut DMatrix<f64>, b: &mut DVector<f64>) -> bool {
+    let n = b.len();
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&i, &j| a[(i, col)].abs().total_cmp(&a[(j, col)].abs()))
+            .unwrap_or(col);
+        if a[(pivot, col)] == 0.0 || !a[(pivot, col)].is_finite() {
+            return false;
+        }
+        if pivot != col {
+            a.swap_rows(pivot, col);
+            b.swap_rows(pivot, col);
+        }
+        for row in (col + 1)..n {
+            let f = a[(row, col)] / a[(col, col)];
+            for k in col..n {
+                a[(row, k)] -= f * a[(col, k)];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    for row in (0..n).rev() {
+        let mut acc = b[row];
+        for k in (row + 1)..n {
+            acc -= a[(row, k)] * b[k];
+        }
+        b[row] = acc / a[(row, row)];
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::contacts::Contacts;
+    use crate::engine::ewald::Ewald;
+    use crate::engine::mobility::Mobility;
+    use crate::engine::periodic::PeriodicBox;
+
+    #[test]
+    fn elimination_solves_a_pivoting_system() {
+        let mut a = DMatrix::from_row_slice(3, 3, &[0.0, 2.0, 1.0, 1.0, 1.0, 1.0, 2.0, 1.0, 3.0]);
+        let x = DVector::from_vec(vec![1.0, -2.0, 0.5]);
+        let mut b = &a * &x;
+        assert!(solve_in_place(&mut a, &mut b));
+        assert!((b - x).amax() < 1e-14);
+    }
+
+    /// A small generator of uniform numbers in [0, 1) (xorshift).
+    struct Rng(u64);
+
+    impl Rng {
+        fn uniform(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn unit_vector(&mut self) -> Vector3<f64> {
+            let z = 2.0 * self.uniform() - 1.0;
+            let phi = 2.0 * std::f64::consts::PI * self.uniform();
+            let rho = (1.0 - z * z).sqrt();
+            Vector3::new(rho * phi.cos(), rho * phi.sin(), z)
+        }
+    }
+
+    /// `count` asymmetric dumbbells at random in a cube of side `side` (spheres may come close:
+    /// the test wants off-diagonal weight), with their orientations and stroke rates.
+    fn dumbbells(
+        count: usize,
+        side: f64,
+        mobility: Mobility,
+    ) -> (Spheres, Vec<Dumbbell>, Vec<Vector3<f64>>, DVector<f64>) {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut d = Dumbbell::default();
+        (d.a1, d.a2) = (0.225 * d.ell, 0.1125 * d.ell);
+        let swimmers: Vec<Dumbbell> = (0..count)
+            .map(|_| {
+                let mut e = d;
+                e.phase = std::f64::consts::TAU * rng.uniform();
+                e
+            })
+            .collect();
+        let contacts = Contacts {
+            allow_overlap: true,
+            steric: None,
+        };
+        let mut spheres = Spheres::new(&swimmers, 1e-3, mobility, contacts);
+        let mut n = Vec::new();
+        for (s, e) in swimmers.iter().enumerate() {
+            let c =
+                Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5) * side;
+            let dir = rng.unit_vector();
+            let (x1, x2) = e.sphere_positions(c, dir, e.rest_length(0.0));
+            spheres.pos[2 * s] = x1;
+            spheres.pos[2 * s + 1] = x2;
+            n.push(dir);
+        }
+        let rate = DVector::from_iterator(
+            count,
+            swimmers.iter().map(|e| e.lambda * e.omega * e.phase.cos()),
+        );
+        (spheres, swimmers, n, rate)
+    }
+
+    /// Every route gives the eliminated tensions: to 1e-9 relative, the iteration's 1e-12
+    /// residual times K's condition number (tens here, where spheres come within a diameter).
+    #[test]
+    fn every_route_gives_the_eliminated_tensions() {
+        for mobility in [Mobility::Rpy, Mobility::Oseen] {
+            let (mut spheres, swimmers, n, rate) = dumbbells(40, 40e-6, mobility);
+            let mut want = rate.clone();
+            Tensions::by(Route::Eliminate, 40).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
+            for route in [Route::OpenPairs, Route::Blocks, Route::Products] {
+                let mut solver = Tensions::by(route, 40);
+                // Twice: the second solve starts from the first's tensions.
+                for _ in 0..2 {
+                    let mut got = rate.clone();
+                    solver.solve(&mut spheres, &swimmers, &n, 0.0, &mut got);
+                    let err = (&got - &want).amax() / want.amax();
+                    assert!(err < 1e-9, "{mobility:?} {route:?}: relative error {err:e}");
+                }
+                assert_eq!(solver.route(), route);
+            }
+        }
+    }
+
+    /// In a periodic box the products (Ewald sums) give the tensions the blocks eliminate.
+    #[test]
+    fn boxed_products_give_the_eliminated_tensions() {
+        let side = 30e-6;
+        let (mut spheres, swimmers, n, rate) = dumbbells(12, side, Mobility::Rpy);
+        let b = PeriodicBox::new([side; 3]).unwrap();
+        let ewald = Ewald::new(b, 1e-3, Mobility::Rpy, 24, 1e-13, None).unwrap();
+        spheres.set_boundary(Boundary::Periodic(b), Box::new(ewald));
+        let mut want = rate.clone();
+        Tensions::by(Route::Eliminate, 12).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
+        let mut solver = Tensions::new(&Boundary::Periodic(b), 12);
+        assert_eq!(solver.route(), Route::Products);
+        let mut got = rate.clone();
+        solver.solve(&mut spheres, &swimmers, &n, 0.0, &mut got);
+        assert!(solver.products() > 1);
+        let err = (&got - &want).amax() / want.amax();
+        assert!(err < 1e-9, "relative error {err:e}");
+    }
+}
