@@ -3,25 +3,17 @@
 //! self-mobility of a lone sphere in a cube.
 
 use super::method::{check_tol, EwaldMethod};
+use super::real;
+use super::reciprocal::{add_reciprocal, Wave};
 use super::spectral::SpectralEwald;
 use super::split::{truncation, Split};
 use crate::engine::error::{invalid, unsupported, Result, Setting};
 use crate::engine::mobility::{block_matrix, self_mobility, Blocks, Mobility, MobilityOperator};
 use crate::engine::parallel::PARALLEL_IMAGE_SPHERES;
-use crate::engine::periodic::{PeriodicBox, WavePhases};
+use crate::engine::periodic::PeriodicBox;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
-
-/// One reciprocal vector of the half space (its partner −k adds the same real part).
-#[derive(Debug, Clone, Copy)]
-struct Wave {
-    n: [i64; 3],
-    k: Vector3<f64>,
-    k2: f64,
-    /// 2 (6π/V)(1 + k²/4ξ² + k⁴/8ξ⁴) e^{−k²/4ξ²}/k², in units of 1/(6πμ).
-    g: f64,
-}
 
 /// The periodic mobility of spheres in one box, with its splitting and truncation fixed.
 #[derive(Debug, Clone)]
@@ -75,18 +67,23 @@ impl Ewald {
             None => {
                 let n = spheres.max(1) as f64;
                 let lmin = periodic.shortest();
-                // Measured costs per term: an image within r_c (erfc and exp) ~25 units, a
-                // lattice shift tested ~1, a wave per sphere ~10 (its phase and the sum, twice).
-                (0..=80)
+                // Measured costs per term: an image within r_c (erfc and exp) ~25 units; with
+                // r_c ≤ L/2 the cell lists' candidates (27 cells of side r_c around each sphere)
+                // ~1.5 each, else every lattice shift tested per pair ~1; a wave per sphere ~1
+                // (its phase, the structure factors and the velocity, in vector lanes).
+                let cost = |xi: f64| {
+                    let (im, wv) = counts(xi);
+                    let rc = p / xi;
+                    let real = if real::fits(&periodic, rc) {
+                        n * n * (25.0 * im + 1.5 * 27.0 * rc.powi(3) / volume)
+                    } else {
+                        n * n * (25.0 * im + 27.0f64.max(8.0 * im))
+                    };
+                    real + n * wv
+                };
+                (0..=120)
                     .map(|i| 0.5 * 10f64.powf(i as f64 / 40.0) / lmin)
-                    .min_by(|a, b| {
-                        let cost = |xi: f64| {
-                            let (im, wv) = counts(xi);
-                            let tested = 27.0f64.max(8.0 * im);
-                            n * n * (25.0 * im + tested) + 10.0 * n * wv
-                        };
-                        cost(*a).total_cmp(&cost(*b))
-                    })
+                    .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
                     .unwrap_or(PI.sqrt() / lmin)
             }
         };
@@ -266,69 +263,51 @@ impl Ewald {
         let n = pos.len();
         let unit = 1.0 / (6.0 * PI * self.split.mu);
         let parallel = n >= PARALLEL_IMAGE_SPHERES;
-        // Reciprocal space: per wave, C = Σ_j F_j e^{−ik·x_j} and D = Σ_j a_j² F_j e^{−ik·x_j}.
-        let phases = WavePhases::new(&self.periodic, pos, self.n_max);
-        let sums = |w: &Wave| {
-            let mut c = [[0.0; 2]; 3];
-            let mut d = [[0.0; 2]; 3];
-            for j in 0..n {
-                let (re, im) = phases.at(j, w.n);
-                // e^{−ik·x} = re − i im.
-                let a2 = if self.split.finite_size {
-                    radii[j] * radii[j]
-                } else {
-                    0.0
-                };
-                for q in 0..3 {
-                    let f = forces[j][q];
-                    c[q][0] += f * re;
-                    c[q][1] -= f * im;
-                    d[q][0] += a2 * f * re;
-                    d[q][1] -= a2 * f * im;
-                }
-            }
-            (c, d)
-        };
-        let wave_sums: Vec<_> = if parallel {
-            self.waves.par_iter().map(sums).collect()
+        out.iter_mut().for_each(|u| *u = Vector3::zeros());
+        add_reciprocal(
+            &self.periodic,
+            &self.waves,
+            self.n_max,
+            self.split.finite_size,
+            pos,
+            radii,
+            forces,
+            out,
+            parallel,
+        );
+        if real::fits(&self.periodic, self.rc) {
+            real::add_real(
+                &self.split,
+                &self.periodic,
+                self.rc,
+                pos,
+                radii,
+                forces,
+                out,
+                parallel,
+            );
         } else {
-            self.waves.iter().map(sums).collect()
-        };
-        let row = |i: usize, u: &mut Vector3<f64>| {
-            let mut v = Vector3::zeros();
-            for j in 0..n {
-                let r0 = self.periodic.min_image(pos[i] - pos[j]);
-                v += self.real_apply(&r0, self.split.s(radii[i], radii[j]), &forces[j]);
-                if j != i {
-                    v += self
-                        .split
-                        .overlap_apply(&r0, radii[i], radii[j], &forces[j])
-                        / unit;
+            let row = |i: usize, u: &mut Vector3<f64>| {
+                let mut v = self.split.self_excess(radii[i]) * forces[i];
+                for j in 0..n {
+                    let r0 = self.periodic.min_image(pos[i] - pos[j]);
+                    v += self.real_apply(&r0, self.split.s(radii[i], radii[j]), &forces[j]);
+                    if j != i {
+                        v += self
+                            .split
+                            .overlap_apply(&r0, radii[i], radii[j], &forces[j])
+                            / unit;
+                    }
                 }
-            }
-            v += self.split.self_excess(radii[i]) * forces[i];
-            let ai2 = if self.split.finite_size {
-                radii[i] * radii[i]
-            } else {
-                0.0
+                *u += v;
             };
-            for (w, (c, d)) in self.waves.iter().zip(&wave_sums) {
-                let (re, im) = phases.at(i, w.n);
-                // Re[e^{ik·x_i}((1 − a_i²k²/6) C − (k²/6) D)] per component.
-                let (p, q) = (1.0 - ai2 * w.k2 / 6.0, -w.k2 / 6.0);
-                let z = Vector3::from_fn(|m, _| {
-                    let (zr, zi) = (p * c[m][0] + q * d[m][0], p * c[m][1] + q * d[m][1]);
-                    re * zr - im * zi
-                });
-                v += w.g * (z - w.k * (w.k.dot(&z) / w.k2));
+            if parallel {
+                out.par_iter_mut().enumerate().for_each(|(i, u)| row(i, u));
+            } else {
+                out.iter_mut().enumerate().for_each(|(i, u)| row(i, u));
             }
-            *u = v * unit;
-        };
-        if parallel {
-            out.par_iter_mut().enumerate().for_each(|(i, u)| row(i, u));
-        } else {
-            out.iter_mut().enumerate().for_each(|(i, u)| row(i, u));
         }
+        out.iter_mut().for_each(|u| *u *= unit);
     }
 
     /// The block M_ij (3×3) between spheres at minimum image separation `r0` = x_i − x_j, radii

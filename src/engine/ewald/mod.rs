@@ -19,17 +19,22 @@
 //!
 //! Truncation: both sums fall as e^{−p²} times a polynomial in p, with p = ξ r_c = k_c/(2ξ); p is
 //! chosen so that e^{−p²}(1 + p⁴) is the tolerance, and ξ to minimise the work for the number of
-//! spheres (all pairs times the images within r_c, against the spheres times the waves within k_c).
+//! spheres (the pairs within r_c, found by cell lists where r_c ≤ L/2 and among all pairs and their
+//! images otherwise, against the spheres times the waves within k_c: O(N^1.5) at the optimum).
 //! The result does not depend on ξ beyond that tolerance (tests/periodic.rs).
 //!
 //! - `method.rs`: [`EwaldMethod`] (auto, Beenakker, spectral) and the tolerance's check;
 //! - `split.rs`: the splitting and the terms both methods share;
 //! - `beenakker.rs`: Beenakker's sums, [`Ewald`] (products, blocks, the matrix) and Hasimoto's
 //!   self-mobility;
+//! - `reciprocal.rs`: the products' reciprocal part through structure factors, in vector lanes;
+//! - `real.rs`: the products' real-space part over cell lists (r_c ≤ L/2);
 //! - `spectral.rs`: spectral Ewald (Lindbo & Tornberg 2010), the products on an FFT grid.
 
 mod beenakker;
 mod method;
+mod real;
+mod reciprocal;
 pub mod spectral;
 mod split;
 

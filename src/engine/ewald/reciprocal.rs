@@ -1,0 +1,177 @@
+//! The reciprocal part of Beenakker's product through structure factors, in vector lanes.
+//!
+//! Per wave k (half space; its partner −k adds the same real part): the phases e^{ik·x_j} of every
+//! sphere from per-axis tables (two complex products a sphere, no sine or cosine), the structure
+//! factors C = Σ_j F_j e^{−ik·x_j} and D = Σ_j a_j² F_j e^{−ik·x_j}, and for every sphere
+//! g Re[e^{ik·x_i}(I − k̂k̂)((1 − a_i²k²/6) C − (k²/6) D)]: O(N) per wave, O(N·K) in all. The
+//! waves are taken in fixed chunks whose sums are added in order, so the result does not depend
+//! on the number of threads.
+
+use crate::engine::periodic::PeriodicBox;
+use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+/// One reciprocal vector of the half space.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Wave {
+    pub(super) n: [i64; 3],
+    pub(super) k: Vector3<f64>,
+    pub(super) k2: f64,
+    /// 2 (6π/V)(1 + k²/4ξ² + k⁴/8ξ⁴) e^{−k²/4ξ²}/k², in units of 1/(6πμ).
+    pub(super) g: f64,
+}
+
+/// Waves per chunk: a chunk's sums are one thread's work and are added in chunk order.
+const CHUNK: usize = 32;
+
+/// The spheres as the wave pass reads them: per-axis phase tables, forces and a²·forces in
+/// lanes.
+struct Lanes {
+    /// Per axis d, e^{i 2π m x_d/L_d} for m = 0 … n_max[d]: re then im, m-major (N per m).
+    re: [Vec<f64>; 3],
+    im: [Vec<f64>; 3],
+    f: [Vec<f64>; 3],
+    fa: [Vec<f64>; 3],
+    /// a² per sphere (0 for Oseen).
+    a2: Vec<f64>,
+    count: usize,
+}
+
+/// Add the reciprocal part, in units of 1/(6πμ), to `out` for spheres at `pos` (radii `radii`,
+/// forces `forces`; `finite`: RPY's a² terms, else Oseen).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn add_reciprocal(
+    periodic: &PeriodicBox,
+    waves: &[Wave],
+    n_max: [usize; 3],
+    finite: bool,
+    pos: &[Vector3<f64>],
+    radii: &[f64],
+    forces: &[Vector3<f64>],
+    out: &mut [Vector3<f64>],
+    parallel: bool,
+) {
+    let count = pos.len();
+    let l = periodic.sides();
+    let table = |d: usize| {
+        let m_count = n_max[d] + 1;
+        let (mut re, mut im) = (vec![0.0; m_count * count], vec![0.0; m_count * count]);
+        for (j, p) in pos.iter().enumerate() {
+            let (s1, c1) = (2.0 * std::f64::consts::PI * p[d] / l[d]).sin_cos();
+            let (mut a, mut b) = (1.0, 0.0);
+            for m in 0..m_count {
+                re[m * count + j] = a;
+                im[m * count + j] = b;
+                (a, b) = (a * c1 - b * s1, a * s1 + b * c1);
+            }
+        }
+        (re, im)
+    };
+    let (t0, t1, t2) = (table(0), table(1), table(2));
+    let a2: Vec<f64> = radii
+        .iter()
+        .map(|a| if finite { a * a } else { 0.0 })
+        .collect();
+    let lanes = Lanes {
+        re: [t0.0, t1.0, t2.0],
+        im: [t0.1, t1.1, t2.1],
+        f: [0, 1, 2].map(|q| forces.iter().map(|f| f[q]).collect()),
+        fa: [0, 1, 2].map(|q| forces.iter().zip(&a2).map(|(f, a)| a * f[q]).collect()),
+        a2,
+        count,
+    };
+    let chunk = |ws: &[Wave]| {
+        let mut acc = [vec![0.0; count], vec![0.0; count], vec![0.0; count]];
+        let (mut re, mut im) = (vec![0.0; count], vec![0.0; count]);
+        for w in ws {
+            wave_pass(&lanes, w, &mut acc, &mut re, &mut im);
+        }
+        acc
+    };
+    let sums: Vec<[Vec<f64>; 3]> = if parallel {
+        waves.par_chunks(CHUNK).map(chunk).collect()
+    } else {
+        waves.chunks(CHUNK).map(chunk).collect()
+    };
+    for acc in &sums {
+        for (i, u) in out.iter_mut().enumerate() {
+            *u += Vector3::new(acc[0][i], acc[1][i], acc[2][i]);
+        }
+    }
+}
+
+/// One wave: the phases into `re`, `im`, the structure factors, and every sphere's velocity
+/// added to `acc`.
+#[inline(always)]
+fn wave_pass_body(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], im: &mut [f64]) {
+    let count = l.count;
+    let row = |d: usize| {
+        let m = w.n[d].unsigned_abs() as usize;
+        let sign = if w.n[d] < 0 { -1.0 } else { 1.0 };
+        (
+            &l.re[d][m * count..(m + 1) * count],
+            &l.im[d][m * count..(m + 1) * count],
+            sign,
+        )
+    };
+    let ((xr, xi, _), (yr, yi, sy), (zr, zi, sz)) = (row(0), row(1), row(2));
+    for j in 0..count {
+        // e^{ik·x} = (x)(y)(z), the conjugate along an axis of negative index.
+        let (ar, ai) = (xr[j], xi[j]);
+        let (br, bi) = (yr[j], sy * yi[j]);
+        let (cr, ci) = (ar * br - ai * bi, ar * bi + ai * br);
+        let (dr, di) = (zr[j], sz * zi[j]);
+        re[j] = cr * dr - ci * di;
+        im[j] = cr * di + ci * dr;
+    }
+    // C and D (with e^{−ik·x} = re − i im): 12 sums in lanes.
+    let mut s = [[0.0; LANES]; 12];
+    let full = count / LANES * LANES;
+    for base in (0..full).step_by(LANES) {
+        for q in 0..3 {
+            for k in 0..LANES {
+                let j = base + k;
+                s[4 * q][k] += l.f[q][j] * re[j];
+                s[4 * q + 1][k] -= l.f[q][j] * im[j];
+                s[4 * q + 2][k] += l.fa[q][j] * re[j];
+                s[4 * q + 3][k] -= l.fa[q][j] * im[j];
+            }
+        }
+    }
+    let mut c = [[0.0; 4]; 3];
+    for q in 0..3 {
+        for m in 0..4 {
+            c[q][m] = lane_sum(&s[4 * q + m]);
+        }
+        for j in full..count {
+            c[q][0] += l.f[q][j] * re[j];
+            c[q][1] -= l.f[q][j] * im[j];
+            c[q][2] += l.fa[q][j] * re[j];
+            c[q][3] -= l.fa[q][j] * im[j];
+        }
+    }
+    // (I − k̂k̂) applied to each of Re C, Im C, Re D, Im D.
+    let k = [w.k[0], w.k[1], w.k[2]];
+    let mut pc = [[0.0; 4]; 3];
+    for m in 0..4 {
+        let kv = (k[0] * c[0][m] + k[1] * c[1][m] + k[2] * c[2][m]) / w.k2;
+        for q in 0..3 {
+            pc[q][m] = w.g * (c[q][m] - k[q] * kv);
+        }
+    }
+    let q6 = w.k2 / 6.0;
+    for i in 0..count {
+        let p = 1.0 - l.a2[i] * q6;
+        let (r, m) = (re[i], im[i]);
+        for q in 0..3 {
+            // Re[e^{ik·x_i}(p C − (k²/6) D)] after the projection.
+            acc[q][i] += p * (r * pc[q][0] - m * pc[q][1]) - q6 * (r * pc[q][2] - m * pc[q][3]);
+        }
+    }
+}
+
+vector_dispatch! {
+    /// [`wave_pass_body`] in the widest vector unit present.
+    fn wave_pass(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], im: &mut [f64]) = wave_pass_body;
+}
