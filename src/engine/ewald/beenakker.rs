@@ -2,6 +2,7 @@
 //! waves within the truncation, the matrix-free product, blocks and the dense matrix; Hasimoto's
 //! self-mobility of a lone sphere in a cube.
 
+use super::erfc::ErfcTable;
 use super::method::{check_tol, EwaldMethod};
 use super::real;
 use super::reciprocal::{add_reciprocal, Wave};
@@ -32,6 +33,8 @@ pub struct Ewald {
     n_max: [usize; 3],
     /// Products by the spectral method (blocks and the matrix stay Beenakker's).
     spectral: Option<SpectralEwald>,
+    /// erfc and e^{−x²} of the real-space lanes.
+    erfc: ErfcTable,
 }
 
 impl Ewald {
@@ -67,17 +70,25 @@ impl Ewald {
             None => {
                 let n = spheres.max(1) as f64;
                 let lmin = periodic.shortest();
-                // Measured costs per term: an image within r_c (erfc and exp) ~25 units; with
-                // r_c ≤ L/2 the cell lists' candidates (27 cells of side r_c around each sphere)
-                // ~1.5 each, else every lattice shift tested per pair ~1; a wave per sphere ~1
-                // (its phase, the structure factors and the velocity, in vector lanes).
+                // Measured costs per term, in units of one wave per sphere (its phase, the
+                // structure factors and the velocity, in vector lanes): with r_c ≤ L/2 a
+                // candidate of the cell lists (every sphere in the cells around one, in lanes)
+                // ~3; else an image within r_c (libm's erfc and exp) ~10 and a lattice shift
+                // tested per pair ~0.4.
                 let cost = |xi: f64| {
                     let (im, wv) = counts(xi);
                     let rc = p / xi;
                     let real = if real::fits(&periodic, rc) {
-                        n * n * (25.0 * im + 1.5 * 27.0 * rc.powi(3) / volume)
+                        let frac: f64 = l
+                            .iter()
+                            .map(|side| {
+                                let cells = (side / rc).floor().max(1.0);
+                                cells.min(3.0) / cells
+                            })
+                            .product();
+                        n * n * 3.0 * frac
                     } else {
-                        n * n * (25.0 * im + 27.0f64.max(8.0 * im))
+                        n * n * (10.0 * im + 0.4 * 27.0f64.max(8.0 * im))
                     };
                     real + n * wv
                 };
@@ -159,6 +170,7 @@ impl Ewald {
             waves: list,
             n_max: periodic.wave_index_max(kc),
             spectral: None,
+            erfc: ErfcTable::default(),
         })
     }
 
@@ -280,6 +292,7 @@ impl Ewald {
                 &self.split,
                 &self.periodic,
                 self.rc,
+                &self.erfc,
                 pos,
                 radii,
                 forces,

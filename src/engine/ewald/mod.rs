@@ -28,10 +28,12 @@
 //! - `beenakker.rs`: Beenakker's sums, [`Ewald`] (products, blocks, the matrix) and Hasimoto's
 //!   self-mobility;
 //! - `reciprocal.rs`: the products' reciprocal part through structure factors, in vector lanes;
-//! - `real.rs`: the products' real-space part over cell lists (r_c ≤ L/2);
+//! - `real.rs`: the products' real-space part over cell lists (r_c ≤ L/2), in vector lanes;
+//! - `erfc.rs`: erfc and e^{−x²} from a table and a Taylor series, for the lanes;
 //! - `spectral.rs`: spectral Ewald (Lindbo & Tornberg 2010), the products on an FFT grid.
 
 mod beenakker;
+mod erfc;
 mod method;
 mod real;
 mod reciprocal;

@@ -116,39 +116,68 @@ fn wave_pass_body(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], 
         )
     };
     let ((xr, xi, _), (yr, yi, sy), (zr, zi, sz)) = (row(0), row(1), row(2));
-    for j in 0..count {
-        // e^{ik·x} = (x)(y)(z), the conjugate along an axis of negative index.
+    // e^{ik·x} = (x)(y)(z), the conjugate along an axis of negative index.
+    let phase = |j: usize| {
         let (ar, ai) = (xr[j], xi[j]);
         let (br, bi) = (yr[j], sy * yi[j]);
         let (cr, ci) = (ar * br - ai * bi, ar * bi + ai * br);
         let (dr, di) = (zr[j], sz * zi[j]);
-        re[j] = cr * dr - ci * di;
-        im[j] = cr * di + ci * dr;
-    }
-    // C and D (with e^{−ik·x} = re − i im): 12 sums in lanes.
+        (cr * dr - ci * di, cr * di + ci * dr)
+    };
+    // The phases, and C and D (with e^{−ik·x} = re − i im) as 12 sums in lanes, block by block
+    // (exact blocks converted to arrays: no bounds checks in the lanes' loop).
+    let blocks = count / LANES;
+    let arr = |v: &[f64], b: usize| -> [f64; LANES] {
+        v[b * LANES..(b + 1) * LANES]
+            .try_into()
+            .unwrap_or([0.0; LANES])
+    };
     let mut s = [[0.0; LANES]; 12];
-    let full = count / LANES * LANES;
-    for base in (0..full).step_by(LANES) {
-        for q in 0..3 {
-            for k in 0..LANES {
-                let j = base + k;
-                s[4 * q][k] += l.f[q][j] * re[j];
-                s[4 * q + 1][k] -= l.f[q][j] * im[j];
-                s[4 * q + 2][k] += l.fa[q][j] * re[j];
-                s[4 * q + 3][k] -= l.fa[q][j] * im[j];
+    for b in 0..blocks {
+        let (ar, ai, br, bi, cr, ci) = (
+            arr(xr, b),
+            arr(xi, b),
+            arr(yr, b),
+            arr(yi, b),
+            arr(zr, b),
+            arr(zi, b),
+        );
+        let f = [arr(&l.f[0], b), arr(&l.f[1], b), arr(&l.f[2], b)];
+        let fa = [arr(&l.fa[0], b), arr(&l.fa[1], b), arr(&l.fa[2], b)];
+        let mut pr = [0.0; LANES];
+        let mut pi = [0.0; LANES];
+        for k in 0..LANES {
+            let (yr_, yi_) = (br[k], sy * bi[k]);
+            let (er, ei) = (ar[k] * yr_ - ai[k] * yi_, ar[k] * yi_ + ai[k] * yr_);
+            let (zr_, zi_) = (cr[k], sz * ci[k]);
+            let (r, m) = (er * zr_ - ei * zi_, er * zi_ + ei * zr_);
+            pr[k] = r;
+            pi[k] = m;
+            for q in 0..3 {
+                s[4 * q][k] += f[q][k] * r;
+                s[4 * q + 1][k] -= f[q][k] * m;
+                s[4 * q + 2][k] += fa[q][k] * r;
+                s[4 * q + 3][k] -= fa[q][k] * m;
             }
         }
+        re[b * LANES..(b + 1) * LANES].copy_from_slice(&pr);
+        im[b * LANES..(b + 1) * LANES].copy_from_slice(&pi);
     }
     let mut c = [[0.0; 4]; 3];
     for q in 0..3 {
         for m in 0..4 {
             c[q][m] = lane_sum(&s[4 * q + m]);
         }
-        for j in full..count {
-            c[q][0] += l.f[q][j] * re[j];
-            c[q][1] -= l.f[q][j] * im[j];
-            c[q][2] += l.fa[q][j] * re[j];
-            c[q][3] -= l.fa[q][j] * im[j];
+    }
+    for j in blocks * LANES..count {
+        let (r, m) = phase(j);
+        re[j] = r;
+        im[j] = m;
+        for q in 0..3 {
+            c[q][0] += l.f[q][j] * r;
+            c[q][1] -= l.f[q][j] * m;
+            c[q][2] += l.fa[q][j] * r;
+            c[q][3] -= l.fa[q][j] * m;
         }
     }
     // (I − k̂k̂) applied to each of Re C, Im C, Re D, Im D.
