@@ -152,7 +152,7 @@ enum BenchKind {
     /// and on the GPU when an adapter is present, with fitted power-law exponents.
     Scaling,
     /// The periodic box's mobility product: Beenakker's Ewald sums against spectral Ewald, 64 …
-    /// 15,625 spheres (--quick: up to 512; Beenakker up to 4,096), with open space for scale, the
+    /// 15,625 spheres (--quick: up to 512), with open space for scale, the
     /// methods' difference against the tolerance and the crossover "auto" uses.
     Ewald,
     /// One right-hand side of a suspension at volume fraction 1% in a periodic box and above a

@@ -104,7 +104,7 @@ pub fn run(
         }
         Kind::Ewald => {
             let tol = crate::engine::ewald::DEFAULT_EWALD_TOL;
-            let (max, beenakker_max) = if quick { (512, 512) } else { (15625, 4096) };
+            let (max, beenakker_max) = if quick { (512, 512) } else { (15625, 15625) };
             let rows = ewald::run(max, beenakker_max, tol)?;
             let t = ewald::table(&rows);
             say(&format!(

@@ -16,7 +16,9 @@ use super::contacts::{Contacts, Overlaps, Steric};
 use super::error::{
     invalid, require_finite, require_positive, unsupported, EngineError, Result, Setting,
 };
-use super::ewald::{Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_FROM_SPHERES};
+use super::ewald::{
+    Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
+};
 use super::forces::{ExternalForces, Gravity};
 use super::integrators::{IntegratorSpec, OdeSystem, Reach, Stats};
 use super::mobility::{Mobility, MobilityOperator};

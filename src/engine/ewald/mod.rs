@@ -41,5 +41,7 @@ pub mod spectral;
 mod split;
 
 pub use beenakker::{hasimoto, Ewald};
-pub use method::{check_tol, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_FROM_SPHERES};
+pub use method::{
+    check_tol, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
+};
 pub use spectral::SpectralEwald;

@@ -61,7 +61,7 @@ impl Scene {
     /// What makes the next run far costlier than its length suggests, each as a notice of its
     /// kind with the fix: spectral Ewald sums chosen for a box of few spheres (its FFT grid is
     /// transformed six times a product whatever the number of spheres, while Beenakker's sums
-    /// shrink as N²; below a quarter of the crossover they cost (700/N)² ≳ 16 times less); an
+    /// shrink as N^1.5; below [`SPECTRAL_COSTLY_BELOW`] spheres they cost 4× less or more); an
     /// averaged suspension's cutoff set to half the box, which leaves its neighbour lists no
     /// skin (every right-hand side rebuilds them).
     pub fn cost_notices(&self) -> Vec<(&'static str, EngineError)> {
@@ -69,7 +69,7 @@ impl Scene {
         let mut out = model.cost_notices(self);
         let spheres = self.sphere_count();
         if model.ewald_method(self.ewald_method) == Some(EwaldMethod::Spectral)
-            && spheres < SPECTRAL_FROM_SPHERES / 4
+            && spheres < SPECTRAL_COSTLY_BELOW
         {
             if let Ok(Some(e)) = self.ewald() {
                 if let Some(g) = e.spectral() {
@@ -78,7 +78,7 @@ impl Scene {
                         "spectral Ewald",
                         unsupported(
                             format!(
-                                "this run will cost far more than its length suggests: spectral Ewald sums transform a {a}x{b}x{c} grid six times for every mobility product, whatever the number of spheres, and with {spheres} spheres Beenakker's sums (O(N^2), faster below {SPECTRAL_FROM_SPHERES} spheres) cost far less"
+                                "this run will cost far more than its length suggests: spectral Ewald sums transform a {a}x{b}x{c} grid six times for every mobility product, whatever the number of spheres, and with {spheres} spheres Beenakker's sums (O(N^1.5), faster below {SPECTRAL_FROM_SPHERES} spheres) cost far less"
                             ),
                             &[Setting::EwaldMethod("auto"), Setting::EwaldMethod("beenakker")],
                         ),
