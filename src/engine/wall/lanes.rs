@@ -191,9 +191,8 @@ fn rows_impl<U: InvSqrt>(s: &WallSpheres, first: usize, last: usize, u: &mut Wal
         for b in 0..blocks {
             let o = start + b * LANES;
             let l8 = o..o + LANES;
-            let lanes = |v: &[f64]| -> [f64; LANES] {
-                v[l8.clone()].try_into().unwrap_or([0.0; LANES])
-            };
+            let lanes =
+                |v: &[f64]| -> [f64; LANES] { v[l8.clone()].try_into().unwrap_or([0.0; LANES]) };
             let (x, y, z, a2) = (lanes(&s.x), lanes(&s.y), lanes(&s.z), lanes(&s.a2));
             let (fx, fy, fz) = (lanes(&s.fx), lanes(&s.fy), lanes(&s.fz));
             let (Ok(ux), Ok(uy), Ok(uz)) = (
