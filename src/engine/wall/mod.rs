@@ -3,8 +3,10 @@
 //!
 //! - `plane.rs`: [`Wall`], the plane and its repulsion;
 //! - `operator.rs`: [`WallMobility`], the mobility above it;
-//! - `rpb.rs`: the Rotne-Prager-Blake wall correction.
+//! - `rpb.rs`: the Rotne-Prager-Blake wall correction;
+//! - `lanes.rs`: its pair terms over all pairs in vector lanes, the product's kernel.
 
+mod lanes;
 mod operator;
 mod plane;
 pub mod rpb;
