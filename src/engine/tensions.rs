@@ -10,17 +10,21 @@
 //! - a few swimmers outside a box: K from the boundary's blocks, Gaussian elimination;
 //! - open space: K from the pair coefficients, contracted with the orientations as it is filled
 //!   (O(S²), the cost of about one mobility product), then conjugate gradients on the matrix;
-//! - a wall: K from the wall's blocks, then conjugate gradients on the matrix;
-//! - a periodic box (whose blocks are whole Ewald sums) and beyond [`DENSE_MATRIX_UP_TO`]
-//!   swimmers: conjugate gradients over mobility products (K T is one product), no matrix at all.
+//! - a periodic box (whose blocks are whole Ewald sums), a wall (whose products run in vector
+//!   lanes, and whose blocks do not) and beyond [`DENSE_MATRIX_UP_TO`] swimmers: conjugate
+//!   gradients over mobility products (K T is one product), no matrix of K itself.
 //!
-//! The iteration is preconditioned by each dumbbell's own K_σσ in open space and starts from the
-//! last solve's tensions; where it stalls, the blocks and elimination take over. No route has an
-//! S³ term but the elimination of a few swimmers and that fallback.
+//! The iteration on a matrix is preconditioned by each dumbbell's own K_σσ in open space; the
+//! iteration over products (up to [`DENSE_MATRIX_UP_TO`] swimmers) by open space's K at the
+//! minimum images, filled as above and solved on the matrix (an inner iteration, hence the
+//! flexible β), and beyond by the diagonal. Every iteration starts from the last solve's tensions;
+//! where it stalls, the blocks and elimination take over. No route has an S³ term but the
+//! elimination of a few swimmers and that fallback.
 
 use super::boundary::Boundary;
 use super::mobility::self_mobility;
 use super::parallel::PARALLEL_SPHERES;
+use super::periodic::{separation, PeriodicBox};
 use super::simd::vector_dispatch;
 use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
@@ -41,6 +45,10 @@ pub const DENSE_MATRIX_UP_TO: usize = 2048;
 /// the rounding of one product.
 pub const TENSION_RTOL: f64 = 1e-12;
 
+/// The preconditioner's inner iteration stops at this fraction of its right side: tight enough
+/// that the outer iteration sees nearly one linear map, loose enough to cost few matrix products.
+const INNER_RTOL: f64 = 1e-10;
+
 /// Iterations before the elimination takes over (CG ends in S in exact arithmetic; at the
 /// densities the model holds it takes tens).
 const MAX_ITERATIONS: usize = 500;
@@ -52,8 +60,6 @@ pub enum Route {
     Eliminate,
     /// Filled from open space's pair coefficients, iterated on the matrix.
     OpenPairs,
-    /// Filled from the boundary's blocks, iterated on the matrix.
-    Blocks,
     /// Iterated over mobility products.
     Products,
 }
@@ -66,7 +72,7 @@ impl Route {
             _ if swimmers <= ELIMINATE_UP_TO => Route::Eliminate,
             _ if swimmers > DENSE_MATRIX_UP_TO => Route::Products,
             Boundary::Open => Route::OpenPairs,
-            Boundary::Wall(_) => Route::Blocks,
+            Boundary::Wall(_) => Route::Products,
         }
     }
 }
@@ -84,18 +90,33 @@ pub struct Tensions {
     z: DVector<f64>,
     p: DVector<f64>,
     q: DVector<f64>,
+    /// The last preconditioned residual (the flexible β).
+    z_prev: DVector<f64>,
+    /// The box, whose minimum images the open-space K of the preconditioner takes.
+    periodic: Option<PeriodicBox>,
+    /// Whether the products' iteration is preconditioned by open space's K (held in `k`),
+    /// solved on the matrix, instead of the diagonal.
+    near: bool,
+    /// Scratch of the preconditioner's inner iteration.
+    inner: [DVector<f64>; 4],
     products: usize,
 }
 
 impl Tensions {
     /// A solver for `swimmers` dumbbells in `boundary`.
     pub fn new(boundary: &Boundary, swimmers: usize) -> Self {
-        Self::by(Route::for_scene(boundary, swimmers), swimmers)
+        let mut t = Self::by(Route::for_scene(boundary, swimmers), swimmers);
+        if let Boundary::Periodic(b) = boundary {
+            t.periodic = Some(*b);
+        }
+        t
     }
 
     /// A solver for `swimmers` dumbbells that takes `route`.
     pub fn by(route: Route, swimmers: usize) -> Self {
-        let held = route != Route::Products;
+        // The products' iteration holds open space's K as its preconditioner where a matrix fits.
+        let near = route == Route::Products && swimmers <= DENSE_MATRIX_UP_TO;
+        let held = route != Route::Products || near;
         let zeros = || DVector::zeros(swimmers);
         Tensions {
             route,
@@ -112,6 +133,10 @@ impl Tensions {
             z: zeros(),
             p: zeros(),
             q: zeros(),
+            z_prev: zeros(),
+            periodic: None,
+            near,
+            inner: [zeros(), zeros(), zeros(), zeros()],
             products: 0,
         }
     }
@@ -140,14 +165,15 @@ impl Tensions {
         let solved = match self.route {
             Route::Eliminate => false,
             Route::OpenPairs => {
-                fill_open_pairs(spheres, n, &mut self.k);
+                fill_open_pairs(spheres, n, None, &mut self.k);
                 self.iterate(spheres, swimmers, n, t, rate)
             }
-            Route::Blocks => {
-                fill_blocks(spheres, n, &mut self.k);
+            Route::Products => {
+                if self.near {
+                    fill_open_pairs(spheres, n, self.periodic.as_ref(), &mut self.k);
+                }
                 self.iterate(spheres, swimmers, n, t, rate)
             }
-            Route::Products => self.iterate(spheres, swimmers, n, t, rate),
         };
         if !solved {
             eliminate(spheres, n, rate);
@@ -208,8 +234,8 @@ impl Tensions {
         self.apply(spheres, n);
         for s in 0..count {
             self.r[s] = -rate[s] - self.q[s];
-            self.z[s] = self.r[s] / self.diag[s];
         }
+        self.precondition();
         self.p.copy_from(&self.z);
         let mut rz = self.r.dot(&self.z);
         let mut converged = false;
@@ -226,11 +252,12 @@ impl Tensions {
             let alpha = rz / pq;
             x.axpy(alpha, &self.p, 1.0);
             self.r.axpy(-alpha, &self.q, 1.0);
-            for s in 0..count {
-                self.z[s] = self.r[s] / self.diag[s];
-            }
+            self.z_prev.copy_from(&self.z);
+            self.precondition();
             let rz_next = self.r.dot(&self.z);
-            let beta = rz_next / rz;
+            // Flexible (Polak-Ribière) β: the inner solve of the preconditioner is not exactly
+            // the same linear map at every step.
+            let beta = (rz_next - self.r.dot(&self.z_prev)) / rz;
             rz = rz_next;
             self.p.axpy(1.0, &self.z, beta);
         }
@@ -241,6 +268,47 @@ impl Tensions {
         self.last.clear();
         self.last.extend(x.iter());
         true
+    }
+
+    /// z = P⁻¹ r: open space's K solved on the matrix (Jacobi CG to [`INNER_RTOL`]) where it is
+    /// held, else (or where that stalls) each dumbbell's own diagonal.
+    fn precondition(&mut self) {
+        let count = self.r.len();
+        if self.near {
+            let [x, r, z, q] = &mut self.inner;
+            x.fill(0.0);
+            r.copy_from(&self.r);
+            let goal = INNER_RTOL * r.norm();
+            let k = &self.k;
+            for s in 0..count {
+                z[s] = r[s] / k[(s, s)];
+            }
+            let mut p = z.clone();
+            let mut rz = r.dot(z);
+            for _ in 0..MAX_ITERATIONS.min(count + 50) {
+                if r.norm() <= goal {
+                    self.z.copy_from(x);
+                    return;
+                }
+                k.mul_to(&p, q);
+                let pq = p.dot(q);
+                if !(pq > 0.0 && rz.is_finite()) {
+                    break;
+                }
+                let alpha = rz / pq;
+                x.axpy(alpha, &p, 1.0);
+                r.axpy(-alpha, q, 1.0);
+                for s in 0..count {
+                    z[s] = r[s] / k[(s, s)];
+                }
+                let rz_next = r.dot(z);
+                p.axpy(1.0, z, rz_next / rz);
+                rz = rz_next;
+            }
+        }
+        for s in 0..count {
+            self.z[s] = self.r[s] / self.diag[s];
+        }
     }
 }
 
@@ -276,6 +344,9 @@ struct KLanes {
     c8: f64,
     /// 1/3 for RPY (its a² term), 0 for Oseen.
     finite: f64,
+    /// The box's sides and their inverses for minimum images (zeros in open space).
+    l: [f64; 3],
+    inv_l: [f64; 3],
 }
 
 /// Column τ of K for every σ by the far-apart pair tensor (c_I = o + f, c_rr = o − 3f with
@@ -295,7 +366,10 @@ fn k_column_body(l: &KLanes, tau: usize, col: &mut [f64], margin: &mut [f64]) {
         let s2 = [l.p2[0][sg], l.p2[1][sg], l.p2[2][sg]];
         let (sq1, sq2) = (l.q1[sg], l.q2[sg]);
         let term = |a: [f64; 3], qa: f64, b: [f64; 3], qb: f64| {
-            let r = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            let mut r = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            for d in 0..3 {
+                r[d] -= l.l[d] * (r[d] * l.inv_l[d]).round();
+            }
             let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
             let inv_d2 = 1.0 / d2;
             let o = c8 * inv_d2.sqrt();
@@ -326,7 +400,14 @@ vector_dispatch! {
 /// two orientations as it is made: N_σ·H N_τ = c_I N_σ·N_τ + c_rr (N_σ·r)(N_τ·r)/r². Column by
 /// column in vector lanes (in parallel for many spheres); the diagonal and any entry with
 /// overlapping spheres again by the exact pair coefficients.
-fn fill_open_pairs(spheres: &Spheres, n: &[Vector3<f64>], k: &mut DMatrix<f64>) {
+fn fill_open_pairs(
+    spheres: &Spheres,
+    n: &[Vector3<f64>],
+    periodic: Option<&PeriodicBox>,
+    k: &mut DMatrix<f64>,
+) {
+    let l = periodic.map_or([0.0; 3], |b| b.sides());
+    let inv_l = l.map(|v| if v > 0.0 { 1.0 / v } else { 0.0 });
     let count = n.len();
     let (mu, mobility) = (spheres.mu, spheres.mobility);
     let (pos, radii) = (&spheres.pos, &spheres.radii);
@@ -343,6 +424,8 @@ fn fill_open_pairs(spheres: &Spheres, n: &[Vector3<f64>], k: &mut DMatrix<f64>) 
         } else {
             0.0
         },
+        l,
+        inv_l,
     };
     let exact = |sg: usize, tau: usize| {
         let (ns, nt) = (n[sg], n[tau]);
@@ -353,7 +436,7 @@ fn fill_open_pairs(spheres: &Spheres, n: &[Vector3<f64>], k: &mut DMatrix<f64>) 
                 let term = if a == b {
                     self_mobility(mu, radii[a]) * nn
                 } else {
-                    let r = pos[a] - pos[b];
+                    let r = separation(periodic, pos[a] - pos[b]);
                     let d2 = r.norm_squared();
                     let (ci, crr) = mobility.pair_coefficients(mu, d2.sqrt(), radii[a], radii[b]);
                     ci * nn + crr * ns.dot(&r) * nt.dot(&r) / d2
@@ -512,7 +595,7 @@ mod tests {
             let (mut spheres, swimmers, n, rate) = dumbbells(40, 40e-6, mobility);
             let mut want = rate.clone();
             Tensions::by(Route::Eliminate, 40).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
-            for route in [Route::OpenPairs, Route::Blocks, Route::Products] {
+            for route in [Route::OpenPairs, Route::Products] {
                 let mut solver = Tensions::by(route, 40);
                 // Twice: the second solve starts from the first's tensions.
                 for _ in 0..2 {
@@ -524,6 +607,28 @@ mod tests {
                 assert_eq!(solver.route(), route);
             }
         }
+    }
+
+    /// Above a wall the products (the wall's lanes) give the tensions the blocks (the scalar
+    /// Rotne-Prager-Blake terms) eliminate.
+    #[test]
+    fn wall_products_give_the_eliminated_tensions() {
+        use crate::engine::wall::{Wall, WallMobility};
+        let (mut spheres, swimmers, n, rate) = dumbbells(30, 30e-6, Mobility::Rpy);
+        let wall = Wall::at(-20e-6).unwrap();
+        spheres.set_boundary(
+            Boundary::Wall(wall),
+            Box::new(WallMobility::new(1e-3, Mobility::Rpy, wall)),
+        );
+        let mut want = rate.clone();
+        Tensions::by(Route::Eliminate, 30).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
+        let mut solver = Tensions::new(&Boundary::Wall(wall), 30);
+        assert_eq!(solver.route(), Route::Products);
+        let mut got = rate.clone();
+        solver.solve(&mut spheres, &swimmers, &n, 0.0, &mut got);
+        assert!(solver.products() > 1);
+        let err = (&got - &want).amax() / want.amax();
+        assert!(err < 1e-9, "relative error {err:e}");
     }
 
     /// In a periodic box the products (Ewald sums) give the tensions the blocks eliminate.
