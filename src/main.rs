@@ -156,8 +156,8 @@ enum BenchKind {
     /// methods' difference against the tolerance and the crossover "auto" uses.
     Ewald,
     /// One right-hand side of a suspension at volume fraction 1% in a periodic box and above a
-    /// wall against the same swimmers in open space, microscopic and rigid-stroke models, 100 and
-    /// 1,000 swimmers (--quick: 100), side by side.
+    /// wall against the same swimmers in open space, microscopic and rigid-stroke models, 64, 100,
+    /// 256 and 1,000 swimmers (--quick: 100), side by side.
     Boundaries,
     /// Bulk suspensions of the averaged model (~15 min; --quick: ~1 min): one right-hand side of
     /// 10,000 swimmers in a box with a cutoff against 1,024 all pairs, side by side; add_random of

@@ -121,7 +121,7 @@ pub fn run(
             say("\nCSV written to out/bench/ewald.csv")?;
         }
         Kind::Boundaries => {
-            let sizes: &[usize] = if quick { &[100] } else { &[100, 1000] };
+            let sizes: &[usize] = if quick { &[100] } else { &[64, 100, 256, 1000] };
             let rows = boundaries::run(sizes)?;
             let t = boundaries::table(&rows);
             say(&format!(
