@@ -731,6 +731,31 @@ fn bench_ewald_compares_the_methods() {
     assert_eq!(crossover(&synthetic[..3]), None);
 }
 
+/// `swimlab bench boundaries` on small scenes: every boundary and both sphere models give a
+/// finite, positive time, and the table has a row per model and size with the ratios the book
+/// quotes (box over open and wall over open computed from the times, the rigid model's open
+/// space over the spring model's).
+#[test]
+fn bench_boundaries_times_every_boundary() {
+    use swimlab::bench::boundaries::{run, table};
+    let rows = run(&[10]).unwrap();
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        for t in [r.open, r.periodic, r.wall] {
+            assert!(t.is_finite() && t > 0.0, "{r:?}");
+        }
+    }
+    let t = table(&rows);
+    assert_eq!(t.rows.len(), 2);
+    let ratio = |row: usize, col: &str| -> f64 {
+        let k = t.header.iter().position(|h| h == col).unwrap();
+        t.rows[row][k].parse().unwrap()
+    };
+    let want = rows[1].periodic / rows[1].open;
+    assert!((ratio(1, "box_over_open") - want).abs() <= 0.01 * want.max(1.0));
+    assert_eq!(ratio(0, "open_over_micro_open"), 1.0);
+}
+
 /// A box too elongated for the spectral grid: "spectral" says so and names the fixes, "auto"
 /// sums by Beenakker's method instead.
 #[test]
