@@ -12,6 +12,7 @@ pub(crate) mod boundary;
 pub mod build;
 pub(crate) mod calibrate;
 pub(crate) mod cells;
+pub(crate) mod cg;
 pub mod choice;
 pub(crate) mod contacts;
 pub mod continuum;

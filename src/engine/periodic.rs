@@ -132,44 +132,60 @@ pub fn nearest_integer(x: f64) -> f64 {
 }
 
 /// The plane-wave phases e^{ik·x} of points in a box, for the box's wave vectors
-/// k = 2π(n_x/L_x, n_y/L_y, n_z/L_z) with |n_d| ≤ n_max[d]: per point and axis the powers
-/// e^{i 2π n x_d/L_d}, n = 0 … n_max, so that a wave's phase is three complex products, with no
+/// k = 2π(n_x/L_x, n_y/L_y, n_z/L_z) with |n_d| ≤ n_max[d]: per axis and point the powers
+/// e^{i 2π m x_d/L_d}, m = 0 … n_max, so that a wave's phase is three complex products, with no
 /// sine or cosine per wave and point (the Ewald sums' reciprocal part, the structure factor).
+/// Each axis's table is m-major (all points for m = 0, then m = 1, …), so that one power of all
+/// points is a contiguous row, as vector lanes read it.
 #[derive(Debug, Clone)]
 pub struct WavePhases {
-    table: Vec<(f64, f64)>,
-    widths: [usize; 3],
+    re: [Vec<f64>; 3],
+    im: [Vec<f64>; 3],
+    points: usize,
 }
 
 impl WavePhases {
     /// The tables of `points` in box `b` up to `n_max` per axis.
     pub fn new(b: &PeriodicBox, points: &[Vector3<f64>], n_max: [usize; 3]) -> Self {
-        let widths = n_max.map(|m| m + 1);
-        let mut table = Vec::with_capacity(points.len() * (widths[0] + widths[1] + widths[2]));
-        for p in points {
-            for d in 0..3 {
+        let count = points.len();
+        let table = |d: usize| {
+            let powers = n_max[d] + 1;
+            let (mut re, mut im) = (vec![0.0; powers * count], vec![0.0; powers * count]);
+            for (j, p) in points.iter().enumerate() {
                 let (s1, c1) = (2.0 * std::f64::consts::PI * p[d] / b.l[d]).sin_cos();
-                let (mut re, mut im) = (1.0, 0.0);
-                for _ in 0..widths[d] {
-                    table.push((re, im));
-                    (re, im) = (re * c1 - im * s1, re * s1 + im * c1);
+                let (mut a, mut c) = (1.0, 0.0);
+                for m in 0..powers {
+                    re[m * count + j] = a;
+                    im[m * count + j] = c;
+                    (a, c) = (a * c1 - c * s1, a * s1 + c * c1);
                 }
             }
+            (re, im)
+        };
+        let (x, y, z) = (table(0), table(1), table(2));
+        WavePhases {
+            re: [x.0, y.0, z.0],
+            im: [x.1, y.1, z.1],
+            points: count,
         }
-        WavePhases { table, widths }
+    }
+
+    /// e^{i 2π m x_d/L_d} of every point along axis `d`, m ≤ n_max[d]: (re, im) rows.
+    #[inline]
+    pub fn row(&self, d: usize, m: usize) -> (&[f64], &[f64]) {
+        let range = m * self.points..(m + 1) * self.points;
+        (&self.re[d][range.clone()], &self.im[d][range])
     }
 
     /// e^{ik·x_j} for wave index `n` (|n_d| ≤ n_max[d]) as (re, im); a negative n_d conjugates.
     #[inline]
     pub fn at(&self, j: usize, n: [i64; 3]) -> (f64, f64) {
-        let stride = self.widths[0] + self.widths[1] + self.widths[2];
-        let mut base = j * stride;
         let (mut re, mut im) = (1.0, 0.0);
         for (d, &nd) in n.iter().enumerate() {
-            let (a, b) = self.table[base + nd.unsigned_abs() as usize];
+            let k = nd.unsigned_abs() as usize * self.points + j;
+            let (a, b) = (self.re[d][k], self.im[d][k]);
             let b = if nd < 0 { -b } else { b };
             (re, im) = (re * a - im * b, re * b + im * a);
-            base += self.widths[d];
         }
         (re, im)
     }

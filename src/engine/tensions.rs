@@ -22,6 +22,7 @@
 //! elimination of a few swimmers and that fallback.
 
 use super::boundary::Boundary;
+use super::cg::{cg, CgVectors};
 use super::mobility::self_mobility;
 use super::parallel::PARALLEL_SPHERES;
 use super::periodic::{separation, PeriodicBox};
@@ -82,23 +83,22 @@ impl Route {
 pub struct Tensions {
     route: Route,
     k: DMatrix<f64>,
-    last: Vec<f64>,
+    /// The last tensions (the next iteration's start), when `warm`.
+    last: DVector<f64>,
+    warm: bool,
     forces: Vec<f64>,
     velocities: Vec<f64>,
-    diag: Vec<f64>,
-    r: DVector<f64>,
-    z: DVector<f64>,
-    p: DVector<f64>,
-    q: DVector<f64>,
-    /// The last preconditioned residual (the flexible β).
-    z_prev: DVector<f64>,
+    diag: DVector<f64>,
+    /// The iteration's vectors.
+    outer: CgVectors,
     /// The box, whose minimum images the open-space K of the preconditioner takes.
     periodic: Option<PeriodicBox>,
     /// Whether the products' iteration is preconditioned by open space's K (held in `k`),
     /// solved on the matrix, instead of the diagonal.
     near: bool,
-    /// Scratch of the preconditioner's inner iteration.
-    inner: [DVector<f64>; 4],
+    /// The preconditioner's inner iteration: its solution and vectors.
+    inner_x: DVector<f64>,
+    inner: CgVectors,
     products: usize,
 }
 
@@ -125,18 +125,16 @@ impl Tensions {
             } else {
                 DMatrix::zeros(0, 0)
             },
-            last: Vec::new(),
+            last: zeros(),
+            warm: false,
             forces: vec![0.0; 6 * swimmers],
             velocities: vec![0.0; 6 * swimmers],
-            diag: vec![0.0; swimmers],
-            r: zeros(),
-            z: zeros(),
-            p: zeros(),
-            q: zeros(),
-            z_prev: zeros(),
+            diag: zeros(),
+            outer: CgVectors::zeros(swimmers),
             periodic: None,
             near,
-            inner: [zeros(), zeros(), zeros(), zeros()],
+            inner_x: zeros(),
+            inner: CgVectors::zeros(swimmers),
             products: 0,
         }
     }
@@ -176,33 +174,14 @@ impl Tensions {
             }
         };
         if !solved {
-            eliminate(spheres, n, rate);
-            self.last.clear();
-            self.last.extend(rate.iter());
+            eliminate(spheres, n, &mut self.k, rate);
+            self.last.copy_from(rate);
+            self.warm = true;
         }
     }
 
-    /// q = K p, by the matrix or by one mobility product (forces +p N on sphere 1, −p N on
-    /// sphere 2; then N·(u₁ − u₂) per dumbbell).
-    fn apply(&mut self, spheres: &mut Spheres, n: &[Vector3<f64>]) {
-        if self.route != Route::Products {
-            self.k.mul_to(&self.p, &mut self.q);
-            return;
-        }
-        for (s, ns) in n.iter().enumerate() {
-            let v = self.p[s] * ns;
-            self.forces[6 * s..6 * s + 3].copy_from_slice(v.as_slice());
-            self.forces[6 * s + 3..6 * s + 6].copy_from_slice((-v).as_slice());
-        }
-        spheres.apply_mobility(&self.forces, &mut self.velocities);
-        for (s, ns) in n.iter().enumerate() {
-            let u = &self.velocities[6 * s..6 * s + 6];
-            self.q[s] = ns.dot(&Vector3::new(u[0] - u[3], u[1] - u[4], u[2] - u[5]));
-        }
-        self.products += 1;
-    }
-
-    /// Preconditioned conjugate gradients for K T = −rate from the last tensions; the tensions
+    /// Conjugate gradients for K T = −rate from the last tensions, preconditioned by open
+    /// space's K where it is held for the products' iteration, else by the diagonal; the tensions
     /// in `rate`. False (rate untouched) if the residual did not fall to [`TENSION_RTOL`].
     fn iterate(
         &mut self,
@@ -212,103 +191,95 @@ impl Tensions {
         t: f64,
         rate: &mut DVector<f64>,
     ) -> bool {
-        let count = swimmers.len();
         let b_norm = rate.norm();
         if b_norm == 0.0 {
-            self.last.clear();
-            self.last.resize(count, 0.0);
+            self.last.fill(0.0);
+            self.warm = true;
             return true;
         }
+        let Tensions {
+            route,
+            k,
+            last: x,
+            warm,
+            forces,
+            velocities,
+            diag,
+            outer,
+            near,
+            inner_x,
+            inner,
+            products,
+            ..
+        } = self;
         // Jacobi: each dumbbell's own K_σσ in open space, 1/(6πμa1) + 1/(6πμa2) − 2 N·H₁₂N.
         let (mu, mobility) = (spheres.mu, spheres.mobility);
         for (s, d) in swimmers.iter().enumerate() {
             let (ci, crr) = mobility.pair_coefficients(mu, d.rest_length(t), d.a1, d.a2);
-            self.diag[s] = self_mobility(mu, d.a1) + self_mobility(mu, d.a2) - 2.0 * (ci + crr);
+            diag[s] = self_mobility(mu, d.a1) + self_mobility(mu, d.a2) - 2.0 * (ci + crr);
         }
-        let mut x = if self.last.len() == count && self.last.iter().all(|v| v.is_finite()) {
-            DVector::from_column_slice(&self.last)
-        } else {
-            DVector::from_iterator(count, rate.iter().zip(&self.diag).map(|(b, d)| -b / d))
+        if !(*warm && x.iter().all(|v| v.is_finite())) {
+            x.zip_apply(rate, |xs, b| *xs = -b);
+            x.component_div_assign(diag);
+        }
+        // q = K p, by the matrix or by one mobility product (forces +p N on sphere 1, −p N on
+        // sphere 2; then N·(u₁ − u₂) per dumbbell).
+        let by_products = *route == Route::Products;
+        let k = &*k;
+        let mut apply = |p: &DVector<f64>, q: &mut DVector<f64>| {
+            if !by_products {
+                k.mul_to(p, q);
+                return;
+            }
+            for (s, ns) in n.iter().enumerate() {
+                let v = p[s] * ns;
+                forces[6 * s..6 * s + 3].copy_from_slice(v.as_slice());
+                forces[6 * s + 3..6 * s + 6].copy_from_slice((-v).as_slice());
+            }
+            spheres.apply_mobility(forces, velocities);
+            for (s, ns) in n.iter().enumerate() {
+                let u = &velocities[6 * s..6 * s + 6];
+                q[s] = ns.dot(&Vector3::new(u[0] - u[3], u[1] - u[4], u[2] - u[5]));
+            }
+            *products += 1;
         };
-        self.p.copy_from(&x);
-        self.apply(spheres, n);
-        for s in 0..count {
-            self.r[s] = -rate[s] - self.q[s];
-        }
-        self.precondition();
-        self.p.copy_from(&self.z);
-        let mut rz = self.r.dot(&self.z);
-        let mut converged = false;
-        for _ in 0..MAX_ITERATIONS.min(count + 50) {
-            if self.r.norm() <= TENSION_RTOL * b_norm {
-                converged = true;
-                break;
-            }
-            self.apply(spheres, n);
-            let pq = self.p.dot(&self.q);
-            if !(pq > 0.0 && rz.is_finite()) {
-                break;
-            }
-            let alpha = rz / pq;
-            x.axpy(alpha, &self.p, 1.0);
-            self.r.axpy(-alpha, &self.q, 1.0);
-            self.z_prev.copy_from(&self.z);
-            self.precondition();
-            let rz_next = self.r.dot(&self.z);
-            // Flexible (Polak-Ribière) β: the inner solve of the preconditioner is not exactly
-            // the same linear map at every step.
-            let beta = (rz_next - self.r.dot(&self.z_prev)) / rz;
-            rz = rz_next;
-            self.p.axpy(1.0, &self.z, beta);
-        }
-        if !converged {
-            return false;
-        }
-        rate.copy_from(&x);
-        self.last.clear();
-        self.last.extend(x.iter());
-        true
-    }
-
-    /// z = P⁻¹ r: open space's K solved on the matrix (Jacobi CG to [`INNER_RTOL`]) where it is
-    /// held, else (or where that stalls) each dumbbell's own diagonal.
-    fn precondition(&mut self) {
-        let count = self.r.len();
-        if self.near {
-            let [x, r, z, q] = &mut self.inner;
-            x.fill(0.0);
-            r.copy_from(&self.r);
-            let goal = INNER_RTOL * r.norm();
-            let k = &self.k;
-            for s in 0..count {
-                z[s] = r[s] / k[(s, s)];
-            }
-            let mut p = z.clone();
-            let mut rz = r.dot(z);
-            for _ in 0..MAX_ITERATIONS.min(count + 50) {
-                if r.norm() <= goal {
-                    self.z.copy_from(x);
+        // z = P⁻¹ r: open space's K solved on the matrix (Jacobi CG to INNER_RTOL) where it is
+        // held, else (or where that stalls) the diagonal.
+        let near = *near;
+        let precondition = |r: &DVector<f64>, z: &mut DVector<f64>| {
+            if near {
+                inner_x.fill(0.0);
+                inner.r.copy_from(r);
+                let goal = INNER_RTOL * r.norm();
+                let inner_diag = k.diagonal();
+                let solved = cg(
+                    inner_x,
+                    inner,
+                    goal,
+                    MAX_ITERATIONS.min(r.len() + 50),
+                    |p, q| k.mul_to(p, q),
+                    |r, z| z.zip_zip_apply(r, &inner_diag, |zs, rs, d| *zs = rs / d),
+                );
+                if solved {
+                    z.copy_from(inner_x);
                     return;
                 }
-                k.mul_to(&p, q);
-                let pq = p.dot(q);
-                if !(pq > 0.0 && rz.is_finite()) {
-                    break;
-                }
-                let alpha = rz / pq;
-                x.axpy(alpha, &p, 1.0);
-                r.axpy(-alpha, q, 1.0);
-                for s in 0..count {
-                    z[s] = r[s] / k[(s, s)];
-                }
-                let rz_next = r.dot(z);
-                p.axpy(1.0, z, rz_next / rz);
-                rz = rz_next;
             }
+            z.zip_zip_apply(r, diag, |zs, rs, d| *zs = rs / d);
+        };
+        // r = b − K x with b = −rate.
+        apply(x, &mut outer.q);
+        outer
+            .r
+            .zip_zip_apply(rate, &outer.q, |rs, b, q| *rs = -b - q);
+        let max = MAX_ITERATIONS.min(swimmers.len() + 50);
+        if !cg(x, outer, TENSION_RTOL * b_norm, max, apply, precondition) {
+            *warm = false;
+            return false;
         }
-        for s in 0..count {
-            self.z[s] = self.r[s] / self.diag[s];
-        }
+        rate.copy_from(x);
+        *warm = true;
+        true
     }
 }
 
@@ -446,10 +417,10 @@ fn fill_open_pairs(
         }
         sum
     };
-    let column = |tau: usize, col: &mut [f64]| {
-        let mut margin = vec![0.0; count];
-        k_column(&lanes, tau, col, &mut margin);
-        for (sg, (entry, m)) in col.iter_mut().zip(&margin).enumerate() {
+    let column = |tau: usize, col: &mut [f64], margin: &mut Vec<f64>| {
+        margin.resize(count, 0.0);
+        k_column(&lanes, tau, col, margin);
+        for (sg, (entry, m)) in col.iter_mut().zip(margin.iter()).enumerate() {
             if sg == tau || m.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 *entry = exact(sg, tau);
             }
@@ -459,22 +430,26 @@ fn fill_open_pairs(
     if 2 * count >= PARALLEL_SPHERES / 2 {
         data.par_chunks_mut(count)
             .enumerate()
-            .for_each(|(tau, col)| column(tau, col));
+            .for_each_init(Vec::new, |margin, (tau, col)| column(tau, col, margin));
     } else {
-        data.chunks_mut(count)
-            .enumerate()
-            .for_each(|(tau, col)| column(tau, col));
+        let mut margin = Vec::new();
+        for (tau, col) in data.chunks_mut(count).enumerate() {
+            column(tau, col, &mut margin);
+        }
     }
 }
 
 /// The tensions by Gaussian elimination of K (from blocks) against −rate, into `rate`; NaN where
 /// K is singular.
-fn eliminate(spheres: &Spheres, n: &[Vector3<f64>], rate: &mut DVector<f64>) {
+/// `k` is the solver's matrix, overwritten (made S×S where the route held none).
+fn eliminate(spheres: &Spheres, n: &[Vector3<f64>], k: &mut DMatrix<f64>, rate: &mut DVector<f64>) {
     let count = n.len();
-    let mut k = DMatrix::zeros(count, count);
-    fill_blocks(spheres, n, &mut k);
+    if k.nrows() != count {
+        *k = DMatrix::zeros(count, count);
+    }
+    fill_blocks(spheres, n, k);
     rate.neg_mut();
-    if !solve_in_place(&mut k, rate) {
+    if !solve_in_place(k, rate) {
         rate.fill(f64::NAN);
     }
 }
@@ -609,44 +584,44 @@ mod tests {
         }
     }
 
-    /// Above a wall the products (the wall's lanes) give the tensions the blocks (the scalar
-    /// Rotne-Prager-Blake terms) eliminate.
-    #[test]
-    fn wall_products_give_the_eliminated_tensions() {
-        use crate::engine::wall::{Wall, WallMobility};
-        let (mut spheres, swimmers, n, rate) = dumbbells(30, 30e-6, Mobility::Rpy);
-        let wall = Wall::at(-20e-6).unwrap();
-        spheres.set_boundary(
-            Boundary::Wall(wall),
-            Box::new(WallMobility::new(1e-3, Mobility::Rpy, wall)),
-        );
+    /// `count` dumbbells in a cube of side `side` within `boundary` (its mobility `operator`):
+    /// the products' iteration gives the tensions the blocks eliminate, to 1e-9 as above, and
+    /// takes more than one product.
+    fn products_match_elimination(
+        count: usize,
+        side: f64,
+        boundary: Boundary,
+        operator: Box<dyn crate::engine::mobility::MobilityOperator>,
+    ) {
+        let (mut spheres, swimmers, n, rate) = dumbbells(count, side, Mobility::Rpy);
+        spheres.set_boundary(boundary, operator);
         let mut want = rate.clone();
-        Tensions::by(Route::Eliminate, 30).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
-        let mut solver = Tensions::new(&Boundary::Wall(wall), 30);
+        Tensions::by(Route::Eliminate, count).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
+        let mut solver = Tensions::new(&boundary, count);
         assert_eq!(solver.route(), Route::Products);
         let mut got = rate.clone();
         solver.solve(&mut spheres, &swimmers, &n, 0.0, &mut got);
         assert!(solver.products() > 1);
         let err = (&got - &want).amax() / want.amax();
-        assert!(err < 1e-9, "relative error {err:e}");
+        assert!(err < 1e-9, "{boundary:?}: relative error {err:e}");
+    }
+
+    /// Above a wall the products (the wall's lanes) give the tensions the blocks (the scalar
+    /// Rotne-Prager-Blake terms) eliminate.
+    #[test]
+    fn wall_products_give_the_eliminated_tensions() {
+        use crate::engine::wall::{Wall, WallMobility};
+        let wall = Wall::at(-20e-6).unwrap();
+        let operator = Box::new(WallMobility::new(1e-3, Mobility::Rpy, wall));
+        products_match_elimination(30, 30e-6, Boundary::Wall(wall), operator);
     }
 
     /// In a periodic box the products (Ewald sums) give the tensions the blocks eliminate.
     #[test]
     fn boxed_products_give_the_eliminated_tensions() {
         let side = 30e-6;
-        let (mut spheres, swimmers, n, rate) = dumbbells(12, side, Mobility::Rpy);
         let b = PeriodicBox::new([side; 3]).unwrap();
         let ewald = Ewald::new(b, 1e-3, Mobility::Rpy, 24, 1e-13, None).unwrap();
-        spheres.set_boundary(Boundary::Periodic(b), Box::new(ewald));
-        let mut want = rate.clone();
-        Tensions::by(Route::Eliminate, 12).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
-        let mut solver = Tensions::new(&Boundary::Periodic(b), 12);
-        assert_eq!(solver.route(), Route::Products);
-        let mut got = rate.clone();
-        solver.solve(&mut spheres, &swimmers, &n, 0.0, &mut got);
-        assert!(solver.products() > 1);
-        let err = (&got - &want).amax() / want.amax();
-        assert!(err < 1e-9, "relative error {err:e}");
+        products_match_elimination(12, side, Boundary::Periodic(b), Box::new(ewald));
     }
 }

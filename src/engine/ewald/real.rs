@@ -53,8 +53,7 @@ fn row_body(
 ) -> ([f64; 3], bool) {
     let split = input.split;
     let xi_ = split.xi;
-    let (x2, sp) = (xi_ * xi_, std::f64::consts::PI.sqrt());
-    let (x3, x5, x7) = (x2 * xi_, x2 * x2 * xi_, x2 * x2 * x2 * xi_);
+    let inv_sqrt_pi = 1.0 / std::f64::consts::PI.sqrt();
     let finite = if split.finite_size { 0.5 } else { 0.0 };
     let l = input.l;
     let inv_l = l.map(|v| 1.0 / v);
@@ -82,21 +81,12 @@ fn row_body(
                 touching[k] |= other && r2 < touch * touch;
                 let take = other && r2 <= input.rc2 && r2 > 0.0;
                 let r2 = if take { r2 } else { 1.0 };
-                let inv_r2 = 1.0 / r2;
                 let r = r2.sqrt();
                 let inv_r = 1.0 / r;
+                let inv_r2 = inv_r * inv_r;
                 let (erfc, gauss) = input.table.eval(xi_ * r);
-                let e = gauss / sp;
                 let sv = finite * (ai * ai + ba[k] * ba[k]);
-                let ci = erfc * (0.75 * inv_r + 0.5 * sv * inv_r2 * inv_r)
-                    + e * (3.0 * x3 * r2 - 4.5 * xi_
-                        + sv * (4.0 * x7 * r2 * r2 - 20.0 * x5 * r2 + 14.0 * x3 + xi_ * inv_r2));
-                let crr = erfc * (0.75 * inv_r - 1.5 * sv * inv_r2 * inv_r)
-                    + e * (-3.0 * x3 * r2
-                        + 1.5 * xi_
-                        + sv * (-4.0 * x7 * r2 * r2 + 16.0 * x5 * r2
-                            - 2.0 * x3
-                            - 3.0 * xi_ * inv_r2));
+                let (ci, crr) = split.real_with(r, inv_r, sv, erfc, gauss * inv_sqrt_pi);
                 let (fx, fy, fz) = (bfx[k], bfy[k], bfz[k]);
                 let proj = crr * (r0[0] * fx + r0[1] * fy + r0[2] * fz) * inv_r2;
                 let w = if take { 1.0 } else { 0.0 };

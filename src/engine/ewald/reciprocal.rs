@@ -1,13 +1,13 @@
 //! The reciprocal part of Beenakker's product through structure factors, in vector lanes.
 //!
 //! Per wave k (half space; its partner −k adds the same real part): the phases e^{ik·x_j} of every
-//! sphere from per-axis tables (two complex products a sphere, no sine or cosine), the structure
-//! factors C = Σ_j F_j e^{−ik·x_j} and D = Σ_j a_j² F_j e^{−ik·x_j}, and for every sphere
+//! sphere from the box's per-axis tables ([`WavePhases`]: two complex products a sphere, no sine
+//! or cosine), the structure factors C = Σ_j F_j e^{−ik·x_j} and D = Σ_j a_j² F_j e^{−ik·x_j}, and for every sphere
 //! g Re[e^{ik·x_i}(I − k̂k̂)((1 − a_i²k²/6) C − (k²/6) D)]: O(N) per wave, O(N·K) in all. The
 //! waves are taken in fixed chunks whose sums are added in order, so the result does not depend
 //! on the number of threads.
 
-use crate::engine::periodic::PeriodicBox;
+use crate::engine::periodic::{PeriodicBox, WavePhases};
 use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -28,9 +28,7 @@ const CHUNK: usize = 32;
 /// The spheres as the wave pass reads them: per-axis phase tables, forces and a²·forces in
 /// lanes.
 struct Lanes {
-    /// Per axis d, e^{i 2π m x_d/L_d} for m = 0 … n_max[d]: re then im, m-major (N per m).
-    re: [Vec<f64>; 3],
-    im: [Vec<f64>; 3],
+    phases: WavePhases,
     f: [Vec<f64>; 3],
     fa: [Vec<f64>; 3],
     /// a² per sphere (0 for Oseen).
@@ -53,29 +51,12 @@ pub(super) fn add_reciprocal(
     parallel: bool,
 ) {
     let count = pos.len();
-    let l = periodic.sides();
-    let table = |d: usize| {
-        let m_count = n_max[d] + 1;
-        let (mut re, mut im) = (vec![0.0; m_count * count], vec![0.0; m_count * count]);
-        for (j, p) in pos.iter().enumerate() {
-            let (s1, c1) = (2.0 * std::f64::consts::PI * p[d] / l[d]).sin_cos();
-            let (mut a, mut b) = (1.0, 0.0);
-            for m in 0..m_count {
-                re[m * count + j] = a;
-                im[m * count + j] = b;
-                (a, b) = (a * c1 - b * s1, a * s1 + b * c1);
-            }
-        }
-        (re, im)
-    };
-    let (t0, t1, t2) = (table(0), table(1), table(2));
     let a2: Vec<f64> = radii
         .iter()
         .map(|a| if finite { a * a } else { 0.0 })
         .collect();
     let lanes = Lanes {
-        re: [t0.0, t1.0, t2.0],
-        im: [t0.1, t1.1, t2.1],
+        phases: WavePhases::new(periodic, pos, n_max),
         f: [0, 1, 2].map(|q| forces.iter().map(|f| f[q]).collect()),
         fa: [0, 1, 2].map(|q| forces.iter().zip(&a2).map(|(f, a)| a * f[q]).collect()),
         a2,
@@ -107,13 +88,8 @@ pub(super) fn add_reciprocal(
 fn wave_pass_body(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], im: &mut [f64]) {
     let count = l.count;
     let row = |d: usize| {
-        let m = w.n[d].unsigned_abs() as usize;
-        let sign = if w.n[d] < 0 { -1.0 } else { 1.0 };
-        (
-            &l.re[d][m * count..(m + 1) * count],
-            &l.im[d][m * count..(m + 1) * count],
-            sign,
-        )
+        let (re, im) = l.phases.row(d, w.n[d].unsigned_abs() as usize);
+        (re, im, if w.n[d] < 0 { -1.0 } else { 1.0 })
     };
     let ((xr, xi, _), (yr, yi, sy), (zr, zi, sz)) = (row(0), row(1), row(2));
     // e^{ik·x} = (x)(y)(z), the conjugate along an axis of negative index.

@@ -39,18 +39,26 @@ impl Split {
     /// Real-space coefficients (c_I, c_rr) at distance `r` > 0, units 1/(6πμ).
     #[inline]
     pub(super) fn real(&self, r: f64, s: f64) -> (f64, f64) {
+        let xr = self.xi * r;
+        let e = (-xr * xr).exp() / PI.sqrt();
+        self.real_with(r, 1.0 / r, s, libm::erfc(xr), e)
+    }
+
+    /// [`Split::real`] from r, 1/r, and erfc(ξr) and e^{−ξ²r²}/√π however they were computed (libm
+    /// here, a table in the vector lanes of `real.rs`).
+    #[inline(always)]
+    pub(super) fn real_with(&self, r: f64, inv_r: f64, s: f64, erfc: f64, e: f64) -> (f64, f64) {
         let xi = self.xi;
-        let (x2, r2) = (xi * xi, r * r);
-        let erfc = libm::erfc(xi * r);
-        let e = (-x2 * r2).exp() / PI.sqrt();
+        let x2 = xi * xi;
+        let (r2, inv_r2) = (r * r, inv_r * inv_r);
         let (x3, x5, x7) = (x2 * xi, x2 * x2 * xi, x2 * x2 * x2 * xi);
-        let ci = erfc * (0.75 / r + 0.5 * s / (r2 * r))
+        let ci = erfc * (0.75 * inv_r + 0.5 * s * inv_r2 * inv_r)
             + e * (3.0 * x3 * r2 - 4.5 * xi
-                + s * (4.0 * x7 * r2 * r2 - 20.0 * x5 * r2 + 14.0 * x3 + xi / r2));
-        let crr = erfc * (0.75 / r - 1.5 * s / (r2 * r))
+                + s * (4.0 * x7 * r2 * r2 - 20.0 * x5 * r2 + 14.0 * x3 + xi * inv_r2));
+        let crr = erfc * (0.75 * inv_r - 1.5 * s * inv_r2 * inv_r)
             + e * (-3.0 * x3 * r2
                 + 1.5 * xi
-                + s * (-4.0 * x7 * r2 * r2 + 16.0 * x5 * r2 - 2.0 * x3 - 3.0 * xi / r2));
+                + s * (-4.0 * x7 * r2 * r2 + 16.0 * x5 * r2 - 2.0 * x3 - 3.0 * xi * inv_r2));
         (ci, crr)
     }
 
