@@ -13,7 +13,7 @@
 //! (I − hγJ) kᵢ = h f(t + cᵢh, y + Σⱼ aᵢⱼ kⱼ) + hJ Σⱼ γᵢⱼ kⱼ + h² γ̂ᵢ ∂f/∂t, y₁ = y + Σ bᵢ kᵢ.
 
 use super::controller::{self, Adaptive, Attempt, Controller, StepRule};
-use super::system::{fit, OdeSystem, Problem, Stats, StepFailure, Stepper};
+use super::system::{fit, time_derivative, OdeSystem, Problem, Stats, StepFailure, Stepper};
 use nalgebra::{DMatrix, DVector};
 
 pub(super) const GAMMA: f64 = 4.358_665_215_084_59e-1;
@@ -218,13 +218,9 @@ impl Adaptive for Rosenbrock {
         }
         sys.error_scale(y, &mut self.scale);
         sys.rhs(t, y, &mut self.f0);
-        // ∂f/∂t by a forward difference (W-methods need only an approximation).
-        let dt_probe = 1e-7 * (t.abs() + self.control.h.unwrap_or(1e-6)).max(1e-12);
-        sys.rhs(t + dt_probe, y, &mut self.ft);
-        for m in 0..n {
-            self.ft[m] = (self.ft[m] - self.f0[m]) / dt_probe;
-        }
-        stats.rhs_evals += 2;
+        stats.rhs_evals += 1;
+        let h = self.control.h.unwrap_or(1e-6);
+        time_derivative(sys, t, y, h, &self.f0, &mut self.ft, stats);
         self.jac.resize(if bs > 0 { n * bs } else { 0 }, 0.0);
         if bs > 0 {
             sys.jacobian_blocks(t, y, &mut self.jac);

@@ -408,6 +408,25 @@ pub(crate) fn fit(n: usize, buffers: &mut [&mut Vec<f64>]) {
     }
 }
 
+/// ∂f/∂t at (t, y) into `ft` by a forward difference over 1e-7 of the time and step scale `h`
+/// (W-methods need only an approximation), given `f0` = f(t, y); one right-hand side.
+pub(crate) fn time_derivative(
+    sys: &mut dyn OdeSystem,
+    t: f64,
+    y: &[f64],
+    h: f64,
+    f0: &[f64],
+    ft: &mut [f64],
+    stats: &mut Stats,
+) {
+    let dt_probe = 1e-7 * (t.abs() + h).max(1e-12);
+    sys.rhs(t + dt_probe, y, ft);
+    stats.rhs_evals += 1;
+    for (d, f) in ft.iter_mut().zip(f0) {
+        *d = (*d - f) / dt_probe;
+    }
+}
+
 /// Step size of a fixed-step method: the largest h ≤ dt that divides the remaining span evenly, so
 /// a run ends exactly at `t_end`. Returns (h, is_last).
 pub(crate) fn uniform_step(t: f64, t_end: f64, dt: f64) -> (f64, bool) {

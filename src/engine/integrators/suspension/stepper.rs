@@ -4,7 +4,7 @@
 use super::scratch::{Path, Pool, Refinement};
 use crate::engine::integrators::controller::{self, Adaptive, Attempt, Controller, StepRule};
 use crate::engine::integrators::system::{
-    fit, GroupJacobian, OdeSystem, Stats, StepFailure, Stepper,
+    fit, time_derivative, GroupJacobian, OdeSystem, Stats, StepFailure, Stepper,
 };
 
 /// Adaptive ROS34PW2, implicit in the system's stiff groups, at tolerance `tol` of the system's
@@ -99,14 +99,8 @@ impl Adaptive for Suspension {
         stats.rhs_evals += 1;
         self.with_ft = !sys.autonomous();
         if self.with_ft {
-            // ∂f/∂t by a forward difference (W-methods need only an approximation).
             let h = self.control.h.unwrap_or(self.first_step);
-            let dt_probe = 1e-7 * (t.abs() + h).max(1e-12);
-            sys.rhs(t + dt_probe, y, &mut self.ft);
-            stats.rhs_evals += 1;
-            for m in 0..n {
-                self.ft[m] = (self.ft[m] - self.f0[m]) / dt_probe;
-            }
+            time_derivative(sys, t, y, h, &self.f0, &mut self.ft, stats);
         }
         self.jac = sys.stiff_groups(t, y);
         Ok(())
