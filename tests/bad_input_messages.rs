@@ -31,14 +31,16 @@ fn a_full_disk_is_the_commands_error() {
 /// with the status a shell gives a process that SIGPIPE ended (141), as `swimlab run` does.
 #[test]
 fn a_closed_pipe_ends_the_command_quietly() {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+    // The pipe's reading end is closed before the command starts: its output (~55 kB) would
+    // fit in the pipe's buffer, so a reader closed only after the spawn could come too late.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_swimlab"))
         .arg("reference")
-        .stdout(Stdio::piped())
+        .stdout(writer)
         .stderr(Stdio::piped())
-        .spawn()
+        .output()
         .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(141), "{err}");
     assert!(err.is_empty(), "{err}");

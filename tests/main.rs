@@ -1,8 +1,7 @@
 //! The integration tests, one binary: each file below is a module about one invariant or API
 //! area ([Validation](../docs/src/validation.md) lists them with what each checks). One binary
 //! links the crate and its dependencies once instead of once per file; `cargo test --test
-//! suite NAME` runs one area (`walls`, `continuum::`, ...). The script fuzzers send the
-//! process-wide interrupt, so they have their own binary (`tests/fuzz/`).
+//! suite NAME` runs one area (`walls`, `continuum::`, ...; the script fuzzers are `fuzz::`).
 
 mod common;
 
@@ -19,6 +18,7 @@ mod bulk_suspensions;
 mod continuum;
 mod engine_messages;
 mod fields;
+mod fuzz;
 mod gpu;
 mod help_docs;
 mod integrator_order;

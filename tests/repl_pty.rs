@@ -14,7 +14,9 @@ const PROMPT: expectrl::Regex<&str> = expectrl::Regex("\n(\x1b\\[[0-9;?]*[a-zA-Z
 fn start() -> Session {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_swimlab"));
     let hist = std::env::temp_dir().join(format!("swimlab-pty-history-{}", std::process::id()));
-    cmd.env("SWIMLAB_HISTORY", hist).env("TERM", "xterm");
+    cmd.env("SWIMLAB_HISTORY", hist)
+        .env("TERM", "xterm")
+        .env_remove("SWIMLAB_PROGRESS");
     let mut s = Session::spawn(cmd).expect("spawn swimlab in a pty");
     s.set_expect_timeout(Some(Duration::from_secs(20)));
     s.expect(PROMPT).unwrap();

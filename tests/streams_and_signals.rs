@@ -277,3 +277,57 @@ fn a_stream_that_cannot_grow_keeps_whole_rows_and_stops_the_run_with_the_error()
         "{in_memory} rows in memory, {rows} in the file"
     );
 }
+
+/// A front end that runs several scripts at once gives each its own interrupt request
+/// (`interrupt::scoped`): a request stops its own script's runs (a scene's, a plain loop, the
+/// calls of a sweep on rayon's threads) and leaves another script, running meanwhile, alone.
+#[test]
+fn an_interrupt_of_its_own_stops_that_script_alone() {
+    use std::sync::mpsc;
+    use swimlab::script::interrupt::{self, Interrupt};
+    let start = |src: &'static str, stop: Interrupt| {
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            let r = interrupt::scoped(&stop, || {
+                let mut scope = rhai::Scope::new();
+                swimlab::script::run_source("t.rhai", src, &mut scope)
+            });
+            let _ = tx.send((r, Instant::now()));
+        });
+        rx
+    };
+    // Without its interrupt each of these would run for hours (fixed steps: no stroboscopic
+    // macro-steps over the periods).
+    let long = [
+        "let s = scene(); s.add(dumbbell()); s.integrator = rk4(1e-5); s.run_periods(1e6);",
+        "let n = 0; loop { n += 1; }",
+        "sweep([1, 2], |p| { let t = scene(); t.add(dumbbell()); t.integrator = rk4(1e-5); \
+         t.run_periods(1e6); })",
+    ];
+    // Runs a scene for 1.5 s of wall time, across the other script's interrupt.
+    let other = "let s = scene(); s.add(dumbbell()); let t = timestamp(); \
+                 while t.elapsed < 1.5 { s.run_periods(0.05); }";
+    for src in long {
+        let (mine, theirs) = (Interrupt::new(), Interrupt::new());
+        let stopped = start(src, mine.clone());
+        let running = start(other, theirs);
+        std::thread::sleep(Duration::from_millis(300));
+        let asked = Instant::now();
+        mine.request();
+        let (r, _) = stopped
+            .recv_timeout(Duration::from_secs(20))
+            .unwrap_or_else(|_| panic!("not stopped by its interrupt: {src}"));
+        let err = r.expect_err(src);
+        // A run says where it stopped; a statement loop is ended as Rhai ends a script.
+        assert!(
+            err.contains("run interrupted") || err.contains("Script terminated"),
+            "{src}: {err}"
+        );
+        let (r, ended) = running.recv_timeout(Duration::from_secs(60)).unwrap();
+        assert!(r.is_ok(), "the other script was stopped too: {r:?}");
+        assert!(
+            ended > asked,
+            "the other script ended before the interrupt: no check"
+        );
+    }
+}

@@ -140,7 +140,8 @@ fn build(s: &SceneHandle, opts: &Map) -> ScriptResult<ContinuumHandle> {
 /// boundary, with the same progress bar.
 fn run(c: &ContinuumHandle, seconds: f64) -> ScriptResult<()> {
     let mut g = c.lock_mut()?;
-    g.set_interrupt(Some(Arc::new(super::interrupt::requested)));
+    let stop = super::interrupt::current();
+    g.set_interrupt(Some(Arc::new(move || stop.requested())));
     let (t0, period) = (g.time(), Some(g.period()));
     let r = super::progress::with_bar(&mut *g, t0, seconds, period, Continuum::set_progress, |c| {
         c.run(seconds)

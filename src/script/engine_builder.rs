@@ -51,7 +51,8 @@ pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModu
     // quietly (Rhai's own `println!` would panic).
     engine.on_print(|s| super::console::to_stdout(&format!("{s}\n")));
     // Ctrl-C also stops plain script loops between statements.
-    engine.on_progress(|_| interrupt::requested().then(|| "interrupted".into()));
+    let stop = interrupt::current();
+    engine.on_progress(move |_| stop.requested().then(|| "interrupted".into()));
     (engine, embedded)
 }
 

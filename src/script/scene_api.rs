@@ -74,7 +74,8 @@ impl SceneHandle {
     /// A simulation of `scene` whose runs stop on Ctrl-C.
     pub fn new(scene: Scene) -> Self {
         let mut sim = Simulation::new(scene);
-        sim.set_interrupt(Some(Arc::new(interrupt::requested)));
+        let stop = interrupt::current();
+        sim.set_interrupt(Some(Arc::new(move || stop.requested())));
         sim.set_notice(Some(Arc::new(|e: &crate::engine::EngineError| {
             super::console::note(&super::engine_message(e))
         })));

@@ -100,10 +100,14 @@ fn sweep(
     f.set_curry(curry);
     let store = ctx.store_data();
     let engine = ctx.engine();
+    // The calls answer the caller's interrupt: scenes they build take it on rayon's threads.
+    let stop = super::interrupt::current();
     let call = |(k, p): (usize, &Dynamic)| -> Result<Dynamic, (usize, Box<EvalAltResult>)> {
-        let ctx = store.create_context(engine);
-        f.call_within_context::<Dynamic>(&ctx, (p.clone(),))
-            .map_err(|e| (k, e))
+        super::interrupt::scoped(&stop, || {
+            let ctx = store.create_context(engine);
+            f.call_within_context::<Dynamic>(&ctx, (p.clone(),))
+                .map_err(|e| (k, e))
+        })
     };
     let run = || -> Vec<Result<Dynamic, (usize, Box<EvalAltResult>)>> {
         params.par_iter().enumerate().map(call).collect()

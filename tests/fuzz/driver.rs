@@ -4,13 +4,14 @@
 //! (where it shows as an "internal error"), and no message may show a Rust path or debug form.
 //! An abort (out of memory) ends the test process, which fails the test.
 //!
-//! The interrupt is process-wide: the fuzzers take turns through one lock, and their binary
-//! holds no other tests.
+//! Each script runs under an interrupt request of its own (`interrupt::scoped`), so stopping it
+//! stops no other test's run in the same process.
 
 use crate::common::Rng;
 use std::sync::{mpsc, Mutex};
 use std::time::{Duration, Instant};
-use swimlab::script::{interrupt, run_source};
+use swimlab::script::interrupt::{self, Interrupt};
+use swimlab::script::run_source;
 
 /// A script still running after this is interrupted, as a user would press Ctrl-C...
 pub const PATIENCE: Duration = Duration::from_secs(3);
@@ -27,9 +28,6 @@ pub const LEAKS: &[&str] = &[
     "anon$",
     "alloc::",
 ];
-
-/// The fuzzers take turns: the interrupt they send is process-wide.
-static TURN: Mutex<()> = Mutex::new(());
 
 /// A template with its placeholders filled left to right: `V` from `values`, `P` from `paths`.
 /// Values and paths hold no placeholder letters of their own that a later search could take
@@ -90,8 +88,6 @@ impl Fuzz {
         mut make: impl FnMut(&mut Rng) -> String,
         check: impl Fn(usize, &str, &str),
     ) -> String {
-        let _turn = TURN.lock().unwrap_or_else(|e| e.into_inner());
-        std::env::set_var("SWIMLAB_PROGRESS", "0");
         let (seed, scripts) = (
             from_env("SWIMLAB_FUZZ_SEED", self.seed),
             from_env("SWIMLAB_FUZZ_SCRIPTS", self.scripts),
@@ -162,17 +158,21 @@ pub fn fail(msg: String) -> ! {
 fn run_limited(src: &str, captured: bool, rendered: bool) -> Result<Outcome, Option<Outcome>> {
     let (tx, rx) = mpsc::channel();
     let body = src.to_string();
+    let stop = Interrupt::new();
+    let script_stop = stop.clone();
     std::thread::spawn(move || {
-        let (result, text) = if captured {
-            run_captured(&body)
-        } else {
-            (Ok(()), String::new())
-        };
-        let rendered = rendered.then(|| {
-            let mut scope = rhai::Scope::new();
-            run_source("fuzz.rhai", &body, &mut scope).err()
-        });
-        let _ = tx.send((result, text, rendered.flatten()));
+        interrupt::scoped(&script_stop, || {
+            let (result, text) = if captured {
+                run_captured(&body)
+            } else {
+                (Ok(()), String::new())
+            };
+            let rendered = rendered.then(|| {
+                let mut scope = rhai::Scope::new();
+                run_source("fuzz.rhai", &body, &mut scope).err()
+            });
+            let _ = tx.send((result, text, rendered.flatten()));
+        })
     });
     // A thread that panicked outside the renderer's guard drops its sender.
     let died = || {
@@ -187,7 +187,7 @@ fn run_limited(src: &str, captured: bool, rendered: bool) -> Result<Outcome, Opt
     // The rendered run clears the request when it starts: ask until the whole script stops.
     let asked = Instant::now();
     let r = loop {
-        interrupt::request();
+        stop.request();
         match rx.recv_timeout(Duration::from_millis(100)) {
             Ok(r) => break Some(r),
             Err(mpsc::RecvTimeoutError::Disconnected) => break Some(died()),
@@ -197,7 +197,6 @@ fn run_limited(src: &str, captured: bool, rendered: bool) -> Result<Outcome, Opt
             break None;
         }
     };
-    interrupt::clear();
     Err(r)
 }
 
