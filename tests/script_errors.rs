@@ -110,6 +110,12 @@ fn unknown_names_and_wrong_types_are_named() {
     expect("let i = euler(-1e-6);", 1, &["dt", "positive"]);
     expect("let i = dopri5(2.0);", 1, &["rtol"]);
     expect("let i = dopri5(\"tight\");", 1, &["rtol must be a number"]);
+    // A property called as a method is named as the property it is.
+    expect(
+        "let s = scene();\nlet n = s.count();",
+        2,
+        &["Scene.count is a property", "without parentheses"],
+    );
 }
 
 #[test]

@@ -234,6 +234,18 @@ pub(super) fn function_not_found(sig: &str) -> String {
             integer_hint(&call, &args, forms)
         );
     }
+    // A property called as a method: `s.count()` for `s.count`.
+    if let [ty] = args.as_slice() {
+        if voc
+            .getters
+            .get(ty)
+            .is_some_and(|g| g.iter().any(|p| p == name))
+        {
+            return format!(
+                "{ty}.{name} is a property, not a function: write it without parentheses (x.{name}, not x.{name}())"
+            );
+        }
+    }
     let names: Vec<&str> = voc.functions.keys().map(String::as_str).collect();
     match suggest(name, &names) {
         Some(s) => format!(
