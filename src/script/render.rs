@@ -130,6 +130,11 @@ fn describe(err: &EvalAltResult) -> Described {
             plain(*pos, super::limits::data_too_large(what))
         }
         EvalAltResult::ErrorStackOverflow(pos) => plain(*pos, super::limits::call_depth_exceeded()),
+        // The engine's statement check (Ctrl-C, a kernel's interrupt) ends the script here.
+        EvalAltResult::ErrorTerminated(token, pos) if token.to_string() == "interrupted" => plain(
+            *pos,
+            "script interrupted at this statement (Ctrl-C); what it ran before is kept".into(),
+        ),
         other => {
             let pos = other.position();
             let msg = other.to_string();
