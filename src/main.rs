@@ -127,7 +127,7 @@ impl From<BenchKind> for swimlab::bench::report::Kind {
             BenchKind::Pairs => Kind::Pairs,
             BenchKind::Scaling => Kind::Scaling,
             BenchKind::Ewald => Kind::Ewald,
-            BenchKind::Boundaries => Kind::Boundaries,
+            BenchKind::Boundaries { ewald_tol } => Kind::Boundaries { ewald_tol },
             BenchKind::Suspension => Kind::Suspension,
         }
     }
@@ -158,7 +158,11 @@ enum BenchKind {
     /// One right-hand side of a suspension at volume fraction 1% in a periodic box and above a
     /// wall against the same swimmers in open space, microscopic and rigid-stroke models, 64, 100,
     /// 256 and 1,000 swimmers (--quick: 100), side by side.
-    Boundaries,
+    Boundaries {
+        /// The box's Ewald tolerance (default: the scene's default, 1e-10).
+        #[arg(long, value_name = "TOL")]
+        ewald_tol: Option<f64>,
+    },
     /// Bulk suspensions of the averaged model (~15 min; --quick: ~1 min): one right-hand side of
     /// 10,000 swimmers in a box with a cutoff against 1,024 all pairs, side by side; add_random of
     /// 100,000; suspension(tol)'s error against RK4 and its order; runs of 1,000 and 10,000
@@ -184,6 +188,8 @@ fn main() -> ExitCode {
             }
             Some(Command::Bench { which, quick }) => {
                 swimlab::bench::report::run(which.into(), quick, &swimlab::script::console::emit_line)
+                    // The engine's messages (a setting out of range) as a line of their own.
+                    .map_err(|m| if m.ends_with('\n') { m } else { format!("error: {m}\n") })
             }
             Some(Command::Sweep {
                 script,

@@ -734,11 +734,11 @@ fn bench_ewald_compares_the_methods() {
 /// `swimlab bench boundaries` on small scenes: every boundary and both sphere models give a
 /// finite, positive time, and the table has a row per model and size with the ratios the book
 /// quotes (box over open and wall over open computed from the times, the rigid model's open
-/// space over the spring model's).
+/// space over the spring model's); a tolerance out of range is refused.
 #[test]
 fn bench_boundaries_times_every_boundary() {
     use swimlab::bench::boundaries::{run, table};
-    let rows = run(&[10]).unwrap();
+    let rows = run(&[10], None).unwrap();
     assert_eq!(rows.len(), 2);
     for r in &rows {
         for t in [r.open, r.periodic, r.wall] {
@@ -754,6 +754,9 @@ fn bench_boundaries_times_every_boundary() {
     let want = rows[1].periodic / rows[1].open;
     assert!((ratio(1, "box_over_open") - want).abs() <= 0.01 * want.max(1.0));
     assert_eq!(ratio(0, "open_over_micro_open"), 1.0);
+    // `--ewald-tol` out of range is refused with the range, before anything is timed.
+    let e = run(&[10], Some(0.5)).unwrap_err();
+    assert!(e.contains("Ewald tolerance") && e.contains("1e-2"), "{e}");
 }
 
 /// A box too elongated for the spectral grid: "spectral" says so and names the fixes, "auto"

@@ -6,7 +6,8 @@
 //! periodic box of that side, and above a wall just below the cube. The times are medians of
 //! right-hand sides repeated until each series has run ~0.3 s (at least 3), the system built once
 //! (as a run builds it once) and the time advanced by a fortieth of a period between them (as a
-//! run's stages advance; the rigid model's iteration starts from the last tensions).
+//! run's stages advance; the rigid model's iteration starts from the last tensions). The box's
+//! sums keep the scene's default `s.ewald_tol` unless another is given.
 
 use super::table::Table;
 use crate::engine::build::{box_side, random_suspension, Orientations, Phases};
@@ -55,9 +56,14 @@ fn rhs_time(scene: &Scene) -> Result<f64, String> {
     Ok(times[times.len() / 2])
 }
 
-/// `swimmers` random Fig-1 swimmers at φ = 1% under `model`, in open space, a box and above a
-/// wall.
-pub fn measure(model: Model, swimmers: usize, seed: u64) -> Result<Row, String> {
+/// `swimmers` random Fig-1 swimmers at φ = 1% under `model`, in open space, a box (its sums to
+/// `ewald_tol`, else the default) and above a wall.
+pub fn measure(
+    model: Model,
+    swimmers: usize,
+    seed: u64,
+    ewald_tol: Option<f64>,
+) -> Result<Row, String> {
     let err = |e: crate::engine::EngineError| e.to_string();
     // The paper's asymmetric swimmer: a2 = a1/2, a1 = 1.5 Λ with Λ = 0.15 ℓ.
     let mut d = Dumbbell::default();
@@ -65,6 +71,9 @@ pub fn measure(model: Model, swimmers: usize, seed: u64) -> Result<Row, String> 
     let side = box_side(swimmers, &d, PHI).map_err(err)?;
     let mut scene = Scene::new();
     scene.set_model(model);
+    if let Some(tol) = ewald_tol {
+        scene.set_ewald_tol(tol).map_err(err)?;
+    }
     scene.set_box(Some([side; 3])).map_err(err)?;
     random_suspension(
         &mut scene,
@@ -93,12 +102,13 @@ pub fn measure(model: Model, swimmers: usize, seed: u64) -> Result<Row, String> 
     })
 }
 
-/// The microscopic and rigid-stroke models at every size in `sizes`.
-pub fn run(sizes: &[usize]) -> Result<Vec<Row>, String> {
+/// The microscopic and rigid-stroke models at every size in `sizes`, the box's sums to
+/// `ewald_tol` (else the default).
+pub fn run(sizes: &[usize], ewald_tol: Option<f64>) -> Result<Vec<Row>, String> {
     let mut rows = Vec::new();
     for &s in sizes {
         for model in [Model::Micro, Model::Rigid] {
-            rows.push(measure(model, s, 0x5eed + s as u64)?);
+            rows.push(measure(model, s, 0x5eed + s as u64, ewald_tol)?);
         }
     }
     Ok(rows)

@@ -7,7 +7,7 @@ use super::{
 use crate::engine::Model;
 
 /// The benchmarks `swimlab bench` runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Kind {
     /// Every integrator on the Fig-1 pairs: error against work, Pareto front.
     WorkPrecision,
@@ -22,7 +22,10 @@ pub enum Kind {
     /// The periodic box's mobility product by both Ewald methods against size.
     Ewald,
     /// One right-hand side in a box and above a wall against open space.
-    Boundaries,
+    Boundaries {
+        /// The box's Ewald tolerance (`None`: the scene's default).
+        ewald_tol: Option<f64>,
+    },
     /// Bulk suspensions of the averaged model: right-hand side, placement, long runs, accuracy.
     Suspension,
 }
@@ -120,13 +123,14 @@ pub fn run(
                 .map_err(io)?;
             say("\nCSV written to out/bench/ewald.csv")?;
         }
-        Kind::Boundaries => {
+        Kind::Boundaries { ewald_tol } => {
             let sizes: &[usize] = if quick { &[100] } else { &[64, 100, 256, 1000] };
-            let rows = boundaries::run(sizes)?;
+            let rows = boundaries::run(sizes, ewald_tol)?;
             let t = boundaries::table(&rows);
             say(&format!(
-                "one right-hand side, random Fig-1 swimmers at sphere volume fraction {}, the same state in open space, a periodic box and above a wall ({} threads; medians):\n{}",
+                "one right-hand side, random Fig-1 swimmers at sphere volume fraction {}, the same state in open space, a periodic box (ewald_tol {:e}) and above a wall ({} threads; medians):\n{}",
                 boundaries::PHI,
+                ewald_tol.unwrap_or(crate::engine::ewald::DEFAULT_EWALD_TOL),
                 rayon::current_num_threads(),
                 t.render()
             ))?;
