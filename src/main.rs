@@ -188,8 +188,6 @@ fn main() -> ExitCode {
             }
             Some(Command::Bench { which, quick }) => {
                 swimlab::bench::report::run(which.into(), quick, &swimlab::script::console::emit_line)
-                    // The engine's messages (a setting out of range) as a line of their own.
-                    .map_err(|m| if m.ends_with('\n') { m } else { format!("error: {m}\n") })
             }
             Some(Command::Sweep {
                 script,

@@ -31,8 +31,23 @@ pub enum Kind {
 }
 
 /// Run one benchmark, tell `say` its tables line by line (the command line prints them) and
-/// write its CSV and pictures under out/bench/.
+/// write its CSV and pictures under out/bench/. An error is a whole line, "error: ..." (the
+/// engine's messages, such as a setting out of range, come without either).
 pub fn run(
+    which: Kind,
+    quick: bool,
+    say: &dyn Fn(&str) -> Result<(), String>,
+) -> Result<(), String> {
+    run_kind(which, quick, say).map_err(|m| {
+        if m.ends_with('\n') {
+            m
+        } else {
+            format!("error: {m}\n")
+        }
+    })
+}
+
+fn run_kind(
     which: Kind,
     quick: bool,
     say: &dyn Fn(&str) -> Result<(), String>,

@@ -73,6 +73,13 @@ pub fn vector_unit() -> &'static str {
 /// and the lanes of an [`InvSqrt`] block.
 pub const LANES: usize = 8;
 
+/// The block `v[start..start + LANES]` as an array: the kernels' loops over its lanes then need
+/// no bounds checks (the slice's one check is here; a block past `v`'s end panics).
+#[inline(always)]
+pub(crate) fn block(v: &[f64], start: usize) -> [f64; LANES] {
+    v[start..start + LANES].try_into().unwrap_or([0.0; LANES])
+}
+
 /// Sum of the lanes in a fixed pairwise order.
 #[inline(always)]
 pub(crate) fn lane_sum(a: &[f64; LANES]) -> f64 {

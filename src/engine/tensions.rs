@@ -251,14 +251,18 @@ impl Tensions {
                 inner_x.fill(0.0);
                 inner.r.copy_from(r);
                 let goal = INNER_RTOL * r.norm();
-                let inner_diag = k.diagonal();
                 let solved = cg(
                     inner_x,
                     inner,
                     goal,
                     MAX_ITERATIONS.min(r.len() + 50),
                     |p, q| k.mul_to(p, q),
-                    |r, z| z.zip_zip_apply(r, &inner_diag, |zs, rs, d| *zs = rs / d),
+                    // Jacobi on K's own diagonal, read in place.
+                    |r, z| {
+                        for (s, (zs, rs)) in z.iter_mut().zip(r.iter()).enumerate() {
+                            *zs = rs / k[(s, s)];
+                        }
+                    },
                 );
                 if solved {
                     z.copy_from(inner_x);

@@ -10,7 +10,7 @@ use super::erfc::{ErfcTable, X_MAX};
 use super::split::Split;
 use crate::engine::cells::CellGrid;
 use crate::engine::periodic::PeriodicBox;
-use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
+use crate::engine::simd::{block, lane_sum, vector_dispatch, LANES};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -62,10 +62,8 @@ fn row_body(
     for &(start, end) in runs {
         let (start, end) = (start as usize, end as usize);
         for b in (start..end).step_by(LANES) {
-            // The block as arrays (the padding keeps b + LANES within them): no bounds checks
-            // in the lanes' loop.
-            let arr =
-                |v: &[f64]| -> [f64; LANES] { v[b..b + LANES].try_into().unwrap_or([0.0; LANES]) };
+            // The block as arrays (the padding keeps b + LANES within them).
+            let arr = |v: &[f64]| block(v, b);
             let (bx, by, bz, ba) = (arr(&s.x), arr(&s.y), arr(&s.z), arr(&s.a));
             let (bfx, bfy, bfz) = (arr(&s.fx), arr(&s.fy), arr(&s.fz));
             let ids: [usize; LANES] = s.id[b..b + LANES].try_into().unwrap_or([usize::MAX; LANES]);

@@ -8,7 +8,7 @@
 //! on the number of threads.
 
 use crate::engine::periodic::{PeriodicBox, WavePhases};
-use crate::engine::simd::{lane_sum, vector_dispatch, LANES};
+use crate::engine::simd::{block, lane_sum, vector_dispatch, LANES};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
@@ -82,6 +82,16 @@ pub(super) fn add_reciprocal(
     }
 }
 
+/// e^{ik·x} = (x)(y)(z) from a sphere's three axis powers (re, im), the y and z powers conjugated
+/// by `sy`, `sz` = −1 along an axis of negative index (the half space's x index is not negative).
+#[inline(always)]
+fn phase(x: (f64, f64), y: (f64, f64), z: (f64, f64), sy: f64, sz: f64) -> (f64, f64) {
+    let (br, bi) = (y.0, sy * y.1);
+    let (cr, ci) = (x.0 * br - x.1 * bi, x.0 * bi + x.1 * br);
+    let (dr, di) = (z.0, sz * z.1);
+    (cr * dr - ci * di, cr * di + ci * dr)
+}
+
 /// One wave: the phases into `re`, `im`, the structure factors, and every sphere's velocity
 /// added to `acc`.
 #[inline(always)]
@@ -92,22 +102,10 @@ fn wave_pass_body(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], 
         (re, im, if w.n[d] < 0 { -1.0 } else { 1.0 })
     };
     let ((xr, xi, _), (yr, yi, sy), (zr, zi, sz)) = (row(0), row(1), row(2));
-    // e^{ik·x} = (x)(y)(z), the conjugate along an axis of negative index.
-    let phase = |j: usize| {
-        let (ar, ai) = (xr[j], xi[j]);
-        let (br, bi) = (yr[j], sy * yi[j]);
-        let (cr, ci) = (ar * br - ai * bi, ar * bi + ai * br);
-        let (dr, di) = (zr[j], sz * zi[j]);
-        (cr * dr - ci * di, cr * di + ci * dr)
-    };
     // The phases, and C and D (with e^{−ik·x} = re − i im) as 12 sums in lanes, block by block
-    // (exact blocks converted to arrays: no bounds checks in the lanes' loop).
+    // (exact blocks as arrays), then the spheres past the last block.
     let blocks = count / LANES;
-    let arr = |v: &[f64], b: usize| -> [f64; LANES] {
-        v[b * LANES..(b + 1) * LANES]
-            .try_into()
-            .unwrap_or([0.0; LANES])
-    };
+    let arr = |v: &[f64], b: usize| block(v, b * LANES);
     let mut s = [[0.0; LANES]; 12];
     for b in 0..blocks {
         let (ar, ai, br, bi, cr, ci) = (
@@ -123,10 +121,7 @@ fn wave_pass_body(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], 
         let mut pr = [0.0; LANES];
         let mut pi = [0.0; LANES];
         for k in 0..LANES {
-            let (yr_, yi_) = (br[k], sy * bi[k]);
-            let (er, ei) = (ar[k] * yr_ - ai[k] * yi_, ar[k] * yi_ + ai[k] * yr_);
-            let (zr_, zi_) = (cr[k], sz * ci[k]);
-            let (r, m) = (er * zr_ - ei * zi_, er * zi_ + ei * zr_);
+            let (r, m) = phase((ar[k], ai[k]), (br[k], bi[k]), (cr[k], ci[k]), sy, sz);
             pr[k] = r;
             pi[k] = m;
             for q in 0..3 {
@@ -146,7 +141,7 @@ fn wave_pass_body(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], 
         }
     }
     for j in blocks * LANES..count {
-        let (r, m) = phase(j);
+        let (r, m) = phase((xr[j], xi[j]), (yr[j], yi[j]), (zr[j], zi[j]), sy, sz);
         re[j] = r;
         im[j] = m;
         for q in 0..3 {

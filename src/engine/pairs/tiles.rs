@@ -4,7 +4,7 @@
 use super::soa::SoaSpheres;
 use super::tensor::{add_overlapping, prefactors, Kernel};
 use crate::engine::mobility::Mobility;
-use crate::engine::simd::{lane_sum, vector_dispatch, InvSqrt, LANES};
+use crate::engine::simd::{block, lane_sum, vector_dispatch, InvSqrt, LANES};
 use rayon::prelude::*;
 
 /// Spheres per tile of the symmetric kernel: n/32, within these bounds (multiples of [`LANES`]).
@@ -113,8 +113,7 @@ fn half_row<U: InvSqrt, const MASK: bool>(
         ) else {
             continue;
         };
-        let lanes =
-            |v: &[f64]| -> [f64; LANES] { v[o..o + LANES].try_into().unwrap_or([0.0; LANES]) };
+        let lanes = |v: &[f64]| block(v, o);
         let (xb, yb, zb, ab, a2b) = (lanes(x), lanes(y), lanes(z), lanes(a), lanes(a2));
         let (fxb, fyb, fzb) = (lanes(fx), lanes(fy), lanes(fz));
         let seps: [_; LANES] = std::array::from_fn(|l| separation(xb[l], yb[l], zb[l]));

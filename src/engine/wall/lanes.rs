@@ -14,7 +14,7 @@
 //! to h ≥ a. A sphere's own correction (diagonal, from its true radius for either pair kind) is
 //! not here; the operator adds it.
 
-use crate::engine::simd::{lane_sum, vector_dispatch, InvSqrt, LANES};
+use crate::engine::simd::{block, lane_sum, vector_dispatch, InvSqrt, LANES};
 use nalgebra::Vector3;
 
 /// The spheres as structure of arrays: positions relative to the wall (lifted), the radius each
@@ -191,8 +191,7 @@ fn rows_impl<U: InvSqrt>(s: &WallSpheres, first: usize, last: usize, u: &mut Wal
         for b in 0..blocks {
             let o = start + b * LANES;
             let l8 = o..o + LANES;
-            let lanes =
-                |v: &[f64]| -> [f64; LANES] { v[l8.clone()].try_into().unwrap_or([0.0; LANES]) };
+            let lanes = |v: &[f64]| block(v, o);
             let (x, y, z, a2) = (lanes(&s.x), lanes(&s.y), lanes(&s.z), lanes(&s.a2));
             let (fx, fy, fz) = (lanes(&s.fx), lanes(&s.fy), lanes(&s.fz));
             let (Ok(ux), Ok(uy), Ok(uz)) = (
