@@ -7,7 +7,8 @@
 //! right-hand sides repeated until each series has run ~0.3 s (at least 3), the system built once
 //! (as a run builds it once) and the time advanced by a fortieth of a period between them (as a
 //! run's stages advance; the rigid model's iteration starts from the last tensions). The box's
-//! sums keep the scene's default `s.ewald_tol` unless another is given.
+//! sums keep the tolerance the scene's default integrator gives them (`Scene::ewald_tol`) unless
+//! another is given; the table says which.
 
 use super::table::Table;
 use crate::engine::build::{box_side, random_suspension, Orientations, Phases};
@@ -31,6 +32,8 @@ pub struct Row {
     pub periodic: f64,
     /// Above the wall.
     pub wall: f64,
+    /// The box's Ewald tolerance.
+    pub ewald_tol: f64,
 }
 
 /// Median seconds of one right-hand side of `scene` as it is.
@@ -57,7 +60,7 @@ fn rhs_time(scene: &Scene) -> Result<f64, String> {
 }
 
 /// `swimmers` random Fig-1 swimmers at φ = 1% under `model`, in open space, a box (its sums to
-/// `ewald_tol`, else the default) and above a wall.
+/// `ewald_tol`, else the one the default integrator gives them) and above a wall.
 pub fn measure(
     model: Model,
     swimmers: usize,
@@ -72,7 +75,7 @@ pub fn measure(
     let mut scene = Scene::new();
     scene.set_model(model);
     if let Some(tol) = ewald_tol {
-        scene.set_ewald_tol(tol).map_err(err)?;
+        scene.set_ewald_tol(Some(tol)).map_err(err)?;
     }
     scene.set_box(Some([side; 3])).map_err(err)?;
     random_suspension(
@@ -86,6 +89,7 @@ pub fn measure(
     )
     .map_err(err)?;
     let periodic = rhs_time(&scene)?;
+    let ewald_tol = scene.ewald_tol();
     scene.set_box(None).map_err(err)?;
     let open = rhs_time(&scene)?;
     let reach = d.ell + d.lambda + d.a1.max(d.a2);
@@ -99,11 +103,12 @@ pub fn measure(
         open,
         periodic,
         wall,
+        ewald_tol,
     })
 }
 
 /// The microscopic and rigid-stroke models at every size in `sizes`, the box's sums to
-/// `ewald_tol` (else the default).
+/// `ewald_tol` (else the one the default integrator gives them).
 pub fn run(sizes: &[usize], ewald_tol: Option<f64>) -> Result<Vec<Row>, String> {
     let mut rows = Vec::new();
     for &s in sizes {
@@ -120,6 +125,7 @@ pub fn table(rows: &[Row]) -> Table {
     let mut t = Table::new(&[
         "model",
         "swimmers",
+        "ewald_tol",
         "open_s",
         "box_s",
         "wall_s",
@@ -135,6 +141,7 @@ pub fn table(rows: &[Row]) -> Table {
         t.rows.push(vec![
             r.model.name().to_string(),
             r.swimmers.to_string(),
+            format!("{:.1e}", r.ewald_tol),
             format!("{:.3e}", r.open),
             format!("{:.3e}", r.periodic),
             format!("{:.3e}", r.wall),
