@@ -801,7 +801,7 @@ fn bench_boundaries_times_every_boundary() {
     let rows = run(&[10], None).unwrap();
     assert_eq!(rows.len(), 2);
     for r in &rows {
-        for t in [r.open, r.periodic, r.wall] {
+        for t in [r.open, r.periodic, r.wall, r.wall_divergence] {
             assert!(t.is_finite() && t > 0.0, "{r:?}");
         }
     }
@@ -814,6 +814,12 @@ fn bench_boundaries_times_every_boundary() {
     let want = rows[1].periodic / rows[1].open;
     assert!((ratio(1, "box_over_open") - want).abs() <= 0.01 * want.max(1.0));
     assert_eq!(ratio(0, "open_over_micro_open"), 1.0);
+    let want = rows[1].wall_divergence / rows[0].open;
+    assert!((ratio(1, "wall_div_over_micro_open") - want).abs() <= 0.01 * want.max(1.0));
+    assert!(
+        (rows[1].ewald_tol - 1.1e-6).abs() < 1e-20,
+        "the default follows auto(1.1e-5)"
+    );
     // `--ewald-tol` out of range is refused with the range, before anything is timed.
     let e = run(&[10], Some(0.5)).unwrap_err();
     assert!(e.contains("Ewald tolerance") && e.contains("1e-2"), "{e}");

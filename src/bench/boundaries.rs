@@ -8,11 +8,13 @@
 //! (as a run builds it once) and the time advanced by a fortieth of a period between them (as a
 //! run's stages advance; the rigid model's iteration starts from the last tensions). The box's
 //! sums keep the tolerance the scene's default integrator gives them (`Scene::ewald_tol`) unless
-//! another is given; the table says which.
+//! another is given; the table says which. Above the wall the divergence ∇·M, which a thermal
+//! run adds as the drift kT ∇·M once a right-hand side, is timed at the same state.
 
 use super::table::Table;
 use crate::engine::build::{box_side, random_suspension, Orientations, Phases};
-use crate::engine::wall::Wall;
+use crate::engine::mobility::MobilityOperator;
+use crate::engine::wall::{Wall, WallMobility};
 use crate::engine::{Dumbbell, Model, Scene};
 use std::time::Instant;
 
@@ -32,8 +34,39 @@ pub struct Row {
     pub periodic: f64,
     /// Above the wall.
     pub wall: f64,
+    /// The wall's divergence ∇·M (a thermal run's drift kT ∇·M, once a right-hand side).
+    pub wall_divergence: f64,
     /// The box's Ewald tolerance.
     pub ewald_tol: f64,
+}
+
+/// Median seconds of `f`, repeated until the series has run ~0.3 s (at least 3 times).
+fn median_time(mut f: impl FnMut()) -> f64 {
+    let mut times = Vec::new();
+    let start = Instant::now();
+    while times.len() < 3 || (start.elapsed().as_secs_f64() < 0.3 && times.len() < 50) {
+        let s = Instant::now();
+        f();
+        times.push(s.elapsed().as_secs_f64());
+    }
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+/// Median seconds of the wall's divergence ∇·M at the spheres of `scene` (above `wall`).
+fn divergence_time(scene: &Scene, wall: Wall) -> f64 {
+    let mut pos = Vec::new();
+    let mut radii = Vec::new();
+    for (i, d) in scene.swimmers().iter().enumerate() {
+        let (x1, x2) = scene.spheres(i);
+        pos.extend([x1, x2]);
+        radii.extend([d.a1, d.a2]);
+    }
+    let op = WallMobility::new(scene.mu(), scene.mobility(), wall);
+    let mut div = vec![nalgebra::Vector3::zeros(); pos.len()];
+    median_time(|| {
+        op.divergence(&pos, &radii, &mut div);
+    })
 }
 
 /// Median seconds of one right-hand side of `scene` as it is.
@@ -44,19 +77,14 @@ fn rhs_time(scene: &Scene) -> Result<f64, String> {
     let mut dy = vec![0.0; y.len()];
     let h = scene.period().map_err(|e| e.to_string())? / 40.0;
     let mut t = scene.time();
-    let mut times = Vec::new();
-    let start = Instant::now();
-    while times.len() < 3 || (start.elapsed().as_secs_f64() < 0.3 && times.len() < 50) {
+    let time = median_time(|| {
         t += h;
-        let s = Instant::now();
         sys.rhs(t, &y, &mut dy);
-        times.push(s.elapsed().as_secs_f64());
-    }
+    });
     if dy.iter().any(|v| !v.is_finite()) {
         return Err("a right-hand side was not finite".into());
     }
-    times.sort_by(f64::total_cmp);
-    Ok(times[times.len() / 2])
+    Ok(time)
 }
 
 /// `swimmers` random Fig-1 swimmers at φ = 1% under `model`, in open space, a box (its sums to
@@ -93,16 +121,17 @@ pub fn measure(
     scene.set_box(None).map_err(err)?;
     let open = rhs_time(&scene)?;
     let reach = d.ell + d.lambda + d.a1.max(d.a2);
-    scene
-        .set_wall(Some(Wall::at(-0.5 * side - reach).map_err(err)?))
-        .map_err(err)?;
+    let plane = Wall::at(-0.5 * side - reach).map_err(err)?;
+    scene.set_wall(Some(plane)).map_err(err)?;
     let wall = rhs_time(&scene)?;
+    let wall_divergence = divergence_time(&scene, plane);
     Ok(Row {
         model,
         swimmers,
         open,
         periodic,
         wall,
+        wall_divergence,
         ewald_tol,
     })
 }
@@ -119,8 +148,9 @@ pub fn run(sizes: &[usize], ewald_tol: Option<f64>) -> Result<Vec<Row>, String> 
     Ok(rows)
 }
 
-/// The table: seconds per right-hand side in each boundary, the ratios to open space, and the
-/// rigid model's open-space time over the spring model's at the same size.
+/// The table: seconds per right-hand side in each boundary, the ratios to open space, the wall's
+/// divergence over the spring model's right-hand side in open space, and the rigid model's
+/// open-space time over the spring model's at the same size.
 pub fn table(rows: &[Row]) -> Table {
     let mut t = Table::new(&[
         "model",
@@ -131,6 +161,7 @@ pub fn table(rows: &[Row]) -> Table {
         "wall_s",
         "box_over_open",
         "wall_over_open",
+        "wall_div_over_micro_open",
         "open_over_micro_open",
     ]);
     for r in rows {
@@ -147,6 +178,7 @@ pub fn table(rows: &[Row]) -> Table {
             format!("{:.3e}", r.wall),
             format!("{:.2}", r.periodic / r.open),
             format!("{:.2}", r.wall / r.open),
+            format!("{:.2}", r.wall_divergence / micro),
             format!("{:.2}", r.open / micro),
         ]);
     }
