@@ -138,84 +138,55 @@ impl WallMobility {
 
 impl WallMobility {
     /// Whether sphere `x` (radius `a`) lies clear of the damped layer by more than the
-    /// divergence's steps: its blocks are then open space's plus the wall correction alone.
+    /// divergence's steps: the pairs it makes with other such spheres add nothing to the
+    /// divergence (`divergence`).
     #[inline]
     fn clear(&self, x: &Vector3<f64>, a: f64) -> bool {
         x.z - self.wall.z >= a * (1.0 + 2.0 * DIVERGENCE_STEP_IN_RADII)
     }
 
-    /// Add the divergence terms of rows `rows` into `d`: each row's own block, through its
-    /// height, and each pair (α, β > α) both ways, ∂M_αβ/∂x_β into α's and ∂M_βα/∂x_α (the rows
-    /// of ∂M_αβ/∂x_α, M_βα = M_αβᵀ) into β's.
-    ///
-    /// Where both spheres lie clear ([`WallMobility::clear`]) only the wall correction is
-    /// differenced: open space's pair tensors (RPY, overlapping or not, and Oseen) are
-    /// divergence-free in either sphere's position. The correction depends on the in-plane
-    /// offset x_α − x_β and on both heights, so its in-plane derivatives in x_α are those in x_β
-    /// with the sign changed: eight evaluations a pair. Otherwise the whole damped block is
-    /// differenced in all six coordinates.
-    fn divergence_rows(
+    /// Add the pair terms of the divergence of the spheres `rows` into `d`: each lies in the
+    /// damped layer (not [`WallMobility::clear`]), and every pair it makes is differenced both
+    /// ways, ∂M_αβ/∂x_β into α's and ∂M_βα/∂x_α (the rows of ∂M_αβ/∂x_α, M_βα = M_αβᵀ) into β's;
+    /// a pair of two such spheres from its lower index only.
+    fn damped_pair_divergence(
         &self,
         pos: &[Vector3<f64>],
         radii: &[f64],
-        rows: std::ops::Range<usize>,
+        rows: &[usize],
         d: &mut [Vector3<f64>],
     ) {
-        let central =
-            |plus: Matrix3<f64>, minus: Matrix3<f64>, step: f64| (plus - minus) / (2.0 * step);
-        for a in rows {
+        for &a in rows {
             let (xa, ai) = (pos[a], radii[a]);
             let step_a = DIVERGENCE_STEP_IN_RADII * ai;
-            let ez = Vector3::z() * step_a;
-            let (up, down) = (xa + ez, xa - ez);
-            d[a] += central(
-                self.damped_block(&up, &up, ai, ai, true),
-                self.damped_block(&down, &down, ai, ai, true),
-                step_a,
-            )
-            .column(2);
-            for b in a + 1..pos.len() {
+            for b in 0..pos.len() {
                 let (xb, aj) = (pos[b], radii[b]);
+                if b == a || (b < a && !self.clear(&xb, aj)) {
+                    continue;
+                }
                 let step_b = DIVERGENCE_STEP_IN_RADII * aj;
-                if self.clear(&xa, ai) && self.clear(&xb, aj) {
-                    let (ia, ib) = (self.image_radius(ai), self.image_radius(aj));
-                    let la = Vector3::new(xa.x, xa.y, xa.z - self.wall.z);
-                    let lb = Vector3::new(xb.x, xb.y, xb.z - self.wall.z);
-                    let w = |pa: &Vector3<f64>, pb: &Vector3<f64>| {
-                        rpb::wall_correction(self.mu, pa, pb, ia, ib)
-                    };
-                    for k in 0..3 {
-                        let mut e = Vector3::zeros();
-                        e[k] = step_b;
-                        let by_b = central(w(&la, &(lb + e)), w(&la, &(lb - e)), step_b);
-                        d[a] += by_b.column(k);
-                        d[b] += if k < 2 {
-                            -by_b.row(k).transpose()
-                        } else {
-                            let e = Vector3::z() * step_a;
-                            central(w(&(la + e), &lb), w(&(la - e), &lb), step_a)
-                                .row(2)
-                                .transpose()
-                        };
-                    }
-                } else {
-                    let m = |pa: &Vector3<f64>, pb: &Vector3<f64>| {
-                        self.damped_block(pa, pb, ai, aj, false)
-                    };
-                    for k in 0..3 {
-                        let mut e = Vector3::zeros();
-                        e[k] = step_b;
-                        d[a] += central(m(&xa, &(xb + e)), m(&xa, &(xb - e)), step_b).column(k);
-                        let mut e = Vector3::zeros();
-                        e[k] = step_a;
-                        d[b] += central(m(&(xa + e), &xb), m(&(xa - e), &xb), step_a)
-                            .row(k)
-                            .transpose();
-                    }
+                let m =
+                    |pa: &Vector3<f64>, pb: &Vector3<f64>| self.damped_block(pa, pb, ai, aj, false);
+                for k in 0..3 {
+                    let mut e = Vector3::zeros();
+                    e[k] = step_b;
+                    d[a] +=
+                        central_difference(m(&xa, &(xb + e)), m(&xa, &(xb - e)), step_b).column(k);
+                    let mut e = Vector3::zeros();
+                    e[k] = step_a;
+                    d[b] += central_difference(m(&(xa + e), &xb), m(&(xa - e), &xb), step_a)
+                        .row(k)
+                        .transpose();
                 }
             }
         }
     }
+}
+
+/// The central difference (plus − minus)/(2 step).
+#[inline]
+fn central_difference(plus: Matrix3<f64>, minus: Matrix3<f64>, step: f64) -> Matrix3<f64> {
+    (plus - minus) / (2.0 * step)
 }
 
 /// Relative step of the central differences behind the divergence, in units of the radius: the
@@ -304,27 +275,53 @@ impl MobilityOperator for WallMobility {
         })
     }
 
-    /// (∇·M)_α = Σ_β Σ_b ∂M_αβ[·, b]/∂x_β,b by central differences of the closed-form blocks
-    /// ([`WallMobility::divergence_rows`]), rows in fixed chunks in parallel from
-    /// [`PARALLEL_IMAGE_SPHERES`] spheres, the chunks' sums added in chunk order (the result
-    /// does not depend on the threads).
+    /// (∇·M)_α = Σ_β Σ_b ∂M_αβ[·, b]/∂x_β,b by central differences of the closed-form blocks:
+    /// each sphere's own block through its height, and the pairs that a sphere in the damped
+    /// layer makes ([`WallMobility::damped_pair_divergence`], in fixed chunks of those spheres on
+    /// rayon's threads from [`PARALLEL_IMAGE_SPHERES`] spheres, the chunks' sums added in chunk
+    /// order: the result does not depend on the threads). A pair of spheres both clear of the
+    /// layer adds nothing: its block is the Rotne-Prager-Blake tensor, Faxén operators on
+    /// Blake's Green's function, which as the flow of the force on either sphere is
+    /// divergence-free in the other's position (on the differenced blocks: 1e-10 of the self
+    /// terms, their round-off). So the divergence costs O(n), and O(n) more for each sphere
+    /// in the layer.
     fn divergence(&self, pos: &[Vector3<f64>], radii: &[f64], out: &mut [Vector3<f64>]) -> bool {
         if !self.wall.drift {
             return false;
         }
         let n = pos.len();
-        let rows = |w: &[usize]| {
+        for ((o, x), &a) in out.iter_mut().zip(pos).zip(radii) {
+            let step = DIVERGENCE_STEP_IN_RADII * a;
+            let (up, down) = (x + Vector3::z() * step, x - Vector3::z() * step);
+            *o = central_difference(
+                self.damped_block(&up, &up, a, a, true),
+                self.damped_block(&down, &down, a, a, true),
+                step,
+            )
+            .column(2)
+            .into();
+        }
+        let damped: Vec<usize> = (0..n).filter(|&a| !self.clear(&pos[a], radii[a])).collect();
+        if damped.is_empty() {
+            return true;
+        }
+        let pairs = |rows: &[usize]| {
             let mut d = vec![Vector3::zeros(); n];
-            self.divergence_rows(pos, radii, w[0]..w[1], &mut d);
+            self.damped_pair_divergence(pos, radii, rows, &mut d);
             d
         };
         let parts: Vec<Vec<Vector3<f64>>> = if n >= PARALLEL_IMAGE_SPHERES {
-            row_chunks(n, ROW_CHUNKS).par_windows(2).map(rows).collect()
+            damped
+                .par_chunks(damped.len().div_ceil(ROW_CHUNKS))
+                .map(pairs)
+                .collect()
         } else {
-            vec![rows(&[0, n])]
+            vec![pairs(&damped)]
         };
-        for (a, o) in out.iter_mut().enumerate() {
-            *o = parts.iter().map(|d| d[a]).sum();
+        for part in &parts {
+            for (o, d) in out.iter_mut().zip(part) {
+                *o += d;
+            }
         }
         true
     }
@@ -437,14 +434,14 @@ mod tests {
             .collect()
     }
 
-    /// The divergence (pairs once both ways, the wall correction alone for pairs clear of the
-    /// damped layer, rows in parallel chunks) against its definition: RPY and Oseen, unequal
+    /// The divergence (self terms, and pairs with a sphere in the damped layer once both ways;
+    /// pairs clear of it add nothing; rows in parallel chunks) against its definition: RPY and Oseen, unequal
     /// radii, a third of the spheres below one radius, one overlapping pair, the serial and the
     /// parallel path. Tolerance 1e-8 of the largest component: both sides are central differences
     /// at the same step (truncation ~(1e-5)² relative), but the definition also differences open
     /// space's tensor, whose exact divergence is zero and whose differenced one is round-off,
     /// ~1e-16 of a block over a step of 1e-5 radii, ~1e-11 of a divergence term, summed over up
-    /// to ~70 pairs (measured: 2.5e-11 to 6.2e-10); a wrong sign of one in-plane term is off by
+    /// to ~70 pairs (measured: 2.7e-11 to 6.1e-10); a wrong sign of one in-plane term is off by
     /// 0.16.
     #[test]
     fn the_divergence_is_its_definition() {
