@@ -435,14 +435,14 @@ mod tests {
     }
 
     /// The divergence (self terms, and pairs with a sphere in the damped layer once both ways;
-    /// pairs clear of it add nothing; rows in parallel chunks) against its definition: RPY and Oseen, unequal
-    /// radii, a third of the spheres below one radius, one overlapping pair, the serial and the
+    /// pairs clear of it add nothing; rows in parallel chunks) against its definition: RPY and
+    /// Oseen, unequal radii, a third of the spheres below one radius, one overlapping pair, the serial and the
     /// parallel path. Tolerance 1e-8 of the largest component: both sides are central differences
     /// at the same step (truncation ~(1e-5)² relative), but the definition also differences open
     /// space's tensor, whose exact divergence is zero and whose differenced one is round-off,
     /// ~1e-16 of a block over a step of 1e-5 radii, ~1e-11 of a divergence term, summed over up
-    /// to ~70 pairs (measured: 2.7e-11 to 6.1e-10); a wrong sign of one in-plane term is off by
-    /// 0.16.
+    /// to ~70 pairs (measured: 2.7e-11 to 6.1e-10); leaving out the pairs of the spheres in the
+    /// layer is off by 1.1e-4.
     #[test]
     fn the_divergence_is_its_definition() {
         let mu = 1e-3;
