@@ -37,6 +37,10 @@ struct SceneFile {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
     state: Vec<f64>,
+    /// Older files have none: the origins become the state as loaded (the displacements' origin
+    /// kept at the base positions, as `msd()` had it).
+    #[serde(default)]
+    origins: Vec<Origin>,
     time: f64,
     stats: Stats,
     /// "cpu" for files from before backends existed.
@@ -86,6 +90,7 @@ impl SceneFile {
             swimmers: s.swimmers.clone(),
             base: s.base.clone(),
             state: s.state.clone(),
+            origins: s.origins.clone(),
             time: s.time,
             stats: s.stats,
             backend: s.backend,
@@ -111,6 +116,7 @@ impl SceneFile {
             swimmers: self.swimmers,
             base: self.base,
             state: self.state,
+            origins: self.origins,
             time: self.time,
             stats: self.stats,
             backend: self.backend,
@@ -161,7 +167,7 @@ impl Scene {
                 loaded.format
             ));
         }
-        let (s, periodic, wall) = loaded.scene.into_parts();
+        let (mut s, periodic, wall) = loaded.scene.into_parts();
         let n = s.swimmers.len();
         if s.base.len() != n || s.state.len() != STATE_PER_SWIMMER * n {
             return Err(invalid!(
@@ -169,6 +175,32 @@ impl Scene {
                 s.base.len(),
                 s.state.len()
             ));
+        }
+        if s.origins.is_empty() {
+            s.origins = (0..n)
+                .map(|i| Origin {
+                    displacement: Vector3::zeros(),
+                    dir: vec3(&s.state, STATE_PER_SWIMMER * i + 3).normalize(),
+                })
+                .collect();
+        }
+        if s.origins.len() != n {
+            return Err(invalid!(
+                "scene file is inconsistent: {n} swimmers but {} origins; remove \"origins\" to measure from the state as loaded",
+                s.origins.len()
+            ));
+        }
+        for (i, o) in s.origins.iter().enumerate() {
+            let finite = o
+                .displacement
+                .iter()
+                .chain(o.dir.iter())
+                .all(|x| x.is_finite());
+            if !finite || (o.dir.norm() - 1.0).abs() > 1e-9 {
+                return Err(invalid!(
+                    "the origin of swimmer {i} is not a finite displacement and a unit orientation; remove \"origins\" to measure from the state as loaded"
+                ));
+            }
         }
         s.validate(periodic, wall)
     }
