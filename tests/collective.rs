@@ -219,6 +219,24 @@ fn free_brownian_dumbbells_decorrelate_and_spread_at_their_coefficients() {
         );
     }
 
+    // A file from before the origins: displacements from the placement, as before; orientations
+    // from the state as loaded.
+    let mut file: serde_json::Value =
+        serde_json::from_str(&sim.scene().to_json().unwrap()).unwrap();
+    file["scene"].as_object_mut().unwrap().remove("origins");
+    let old = Scene::from_json(&file.to_string()).unwrap();
+    assert_eq!(
+        Observable::Msd.evaluate(&old).unwrap(),
+        sim.measure(&Observable::Msd).unwrap()
+    );
+    let c1 = Observable::OrientationAutocorrelation(1)
+        .evaluate(&old)
+        .unwrap()[0];
+    assert!(
+        (c1 - 1.0).abs() < 1e-15,
+        "C1 of an old file as loaded: {c1}"
+    );
+
     sim.scene_mut().reset_origins();
     let msd = sim.measure(&Observable::Msd).unwrap()[0];
     let c1 = sim

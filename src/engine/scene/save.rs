@@ -167,7 +167,7 @@ impl Scene {
                 loaded.format
             ));
         }
-        let (mut s, periodic, wall) = loaded.scene.into_parts();
+        let (s, periodic, wall) = loaded.scene.into_parts();
         let n = s.swimmers.len();
         if s.base.len() != n || s.state.len() != STATE_PER_SWIMMER * n {
             return Err(invalid!(
@@ -176,6 +176,8 @@ impl Scene {
                 s.state.len()
             ));
         }
+        // The origins after the state is checked: an old file's are read from its orientations.
+        let mut s = s.validate(periodic, wall)?;
         if s.origins.is_empty() {
             s.origins = (0..n)
                 .map(|i| Origin {
@@ -202,7 +204,7 @@ impl Scene {
                 ));
             }
         }
-        s.validate(periodic, wall)
+        Ok(s)
     }
 
     /// Check a scene read from a file, in open space, as the setters check their values, and put
