@@ -155,15 +155,16 @@ pub fn estimate(
 mod tests {
     use super::*;
 
-    /// Exact series give their coefficient exactly and a zero error; a straight MSD with an offset
-    /// (a ballistic start before the window) gives the slope alone.
+    /// Exact series give their coefficient and a zero error, to rounding (the differences of
+    /// values ~1e-11 m² lose ~1e-15 of the slope: 1e-12 relative is far above it); a straight
+    /// MSD with an offset (a ballistic start before the window) gives the slope alone.
     #[test]
     fn exact_series_give_their_coefficient() {
         let t: Vec<f64> = (0..41).map(|k| 0.5 * k as f64).collect();
         let msd: Vec<f64> = t.iter().map(|t| 7e-12 + 6.0 * 2e-13 * t).collect();
         let e = estimate(&t, &msd, Series::Msd { dims: 3 }, Some(2.0), None, None).unwrap();
-        assert!((e.value / 2e-13 - 1.0).abs() < 1e-9, "{e:?}");
-        assert!(e.error < 1e-9 * e.value);
+        assert!((e.value / 2e-13 - 1.0).abs() < 1e-12, "{e:?}");
+        assert!(e.error < 1e-12 * e.value);
         assert_eq!((e.from, e.to, e.slopes.len()), (2.0, 20.0, 10));
         let c: Vec<f64> = t.iter().map(|t| (-6.0 * 0.03 * t).exp()).collect();
         let e = estimate(
