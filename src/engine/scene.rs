@@ -17,7 +17,7 @@ use super::error::{
     invalid, require_finite, require_positive, unsupported, EngineError, Result, Setting,
 };
 use super::ewald::{
-    Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
+    ewald_tol_for, Ewald, EwaldMethod, SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
 };
 use super::forces::{ExternalForces, Gravity};
 use super::integrators::{IntegratorSpec, OdeSystem, Reach, Stats};
@@ -82,8 +82,9 @@ pub struct Scene {
     thermal: Thermal,
     /// Open space, the periodic box or the wall.
     boundary: Boundary,
-    /// Tolerance of the box's Ewald sums.
-    ewald_tol: f64,
+    /// Tolerance of the box's Ewald sums; `None`: the one that serves the run's integrator
+    /// (`Scene::ewald_tol`).
+    ewald_tol: Option<f64>,
     /// How the box's mobility products are summed.
     ewald_method: EwaldMethod,
     /// External forces on the spheres.
@@ -119,7 +120,7 @@ impl Default for Scene {
             backend: Backend::default(),
             thermal: Thermal::default(),
             boundary: Boundary::Open,
-            ewald_tol: DEFAULT_EWALD_TOL,
+            ewald_tol: None,
             ewald_method: EwaldMethod::Auto,
             external: ExternalForces::default(),
         }

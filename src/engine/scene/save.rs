@@ -51,11 +51,9 @@ struct SceneFile {
     thermal: Thermal,
     #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
     periodic: Option<PeriodicBox>,
-    #[serde(
-        default = "default_ewald_tol",
-        skip_serializing_if = "is_default_ewald_tol"
-    )]
-    ewald_tol: f64,
+    /// Saved only when set: a scene that follows its run's integrator keeps following it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    ewald_tol: Option<f64>,
     #[serde(default, skip_serializing_if = "is_auto_ewald")]
     ewald_method: EwaldMethod,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -66,14 +64,6 @@ struct SceneFile {
 
 fn is_auto_ewald(m: &EwaldMethod) -> bool {
     *m == EwaldMethod::Auto
-}
-
-fn default_ewald_tol() -> f64 {
-    DEFAULT_EWALD_TOL
-}
-
-fn is_default_ewald_tol(t: &f64) -> bool {
-    *t == DEFAULT_EWALD_TOL
 }
 
 impl SceneFile {
@@ -219,7 +209,9 @@ impl Scene {
             Steric::new(st.range, st.stiffness)?;
         }
         self.thermal.validate()?;
-        crate::engine::ewald::check_tol(self.ewald_tol)?;
+        if let Some(t) = self.ewald_tol {
+            crate::engine::ewald::check_tol(t)?;
+        }
         if let Some(b) = periodic {
             let mut probe = Scene::new();
             probe.set_box(Some(b.sides()))?;
