@@ -31,6 +31,7 @@ use super::swimmer::{unit_direction, Dumbbell};
 use super::thermal::{NoiseRoot, Thermal};
 use super::wall::Wall;
 use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
 
 mod boundary;
 mod dynamics;
@@ -71,6 +72,8 @@ pub struct Scene {
     pub(in crate::engine) base: Vec<Vector3<f64>>,
     /// See [`super::model`]; the steppers advance it.
     pub(in crate::engine) state: Vec<f64>,
+    /// Where each swimmer's displacement and orientation are measured from.
+    origins: Vec<Origin>,
     pub(in crate::engine) time: f64,
     pub(in crate::engine) stats: Stats,
     /// Where the dynamics run.
@@ -88,6 +91,16 @@ pub struct Scene {
     external: ExternalForces,
 }
 
+/// Where a swimmer's displacement and orientation are measured from (`msd()`, the orientation
+/// autocorrelation): its placement, or the last [`Scene::reset_origins`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Origin {
+    /// The displacement of R_H from its base position then (m).
+    pub displacement: Vector3<f64>,
+    /// The unit orientation N then.
+    pub dir: Vector3<f64>,
+}
+
 impl Default for Scene {
     fn default() -> Self {
         Scene {
@@ -101,6 +114,7 @@ impl Default for Scene {
             swimmers: Vec::new(),
             base: Vec::new(),
             state: Vec::new(),
+            origins: Vec::new(),
             time: 0.0,
             stats: Stats::default(),
             backend: Backend::default(),

@@ -218,7 +218,10 @@ pub fn register(engine: &mut Engine) {
             None => Dynamic::UNIT,
         })
         .register_set("steric", |s: &mut SceneHandle, v: Dynamic| -> ScriptResult<()> {
-            s.borrow_mut()?.scene_mut().set_steric(steric_arg(&v)?);
+            // The value is read before the scene is locked: describing a wrong one (the scene
+            // itself, `s.steric = s`) reads the scene, which would wait on this lock for ever.
+            let steric = steric_arg(&v)?;
+            s.borrow_mut()?.scene_mut().set_steric(steric);
             Ok(())
         })
         .register_get("cutoff", |s: &mut SceneHandle| {

@@ -37,6 +37,10 @@ struct SceneFile {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
     state: Vec<f64>,
+    /// Older files have none: the origins become the state as loaded (the displacements' origin
+    /// kept at the base positions, as `msd()` had it).
+    #[serde(default)]
+    origins: Vec<Origin>,
     time: f64,
     stats: Stats,
     /// "cpu" for files from before backends existed.
@@ -76,6 +80,7 @@ impl SceneFile {
             swimmers: s.swimmers.clone(),
             base: s.base.clone(),
             state: s.state.clone(),
+            origins: s.origins.clone(),
             time: s.time,
             stats: s.stats,
             backend: s.backend,
@@ -101,6 +106,7 @@ impl SceneFile {
             swimmers: self.swimmers,
             base: self.base,
             state: self.state,
+            origins: self.origins,
             time: self.time,
             stats: self.stats,
             backend: self.backend,
@@ -160,7 +166,35 @@ impl Scene {
                 s.state.len()
             ));
         }
-        s.validate(periodic, wall)
+        // The origins after the state is checked: an old file's are read from its orientations.
+        let mut s = s.validate(periodic, wall)?;
+        if s.origins.is_empty() {
+            s.origins = (0..n)
+                .map(|i| Origin {
+                    displacement: Vector3::zeros(),
+                    dir: vec3(&s.state, STATE_PER_SWIMMER * i + 3).normalize(),
+                })
+                .collect();
+        }
+        if s.origins.len() != n {
+            return Err(invalid!(
+                "scene file is inconsistent: {n} swimmers but {} origins; remove \"origins\" to measure from the state as loaded",
+                s.origins.len()
+            ));
+        }
+        for (i, o) in s.origins.iter().enumerate() {
+            let finite = o
+                .displacement
+                .iter()
+                .chain(o.dir.iter())
+                .all(|x| x.is_finite());
+            if !finite || (o.dir.norm() - 1.0).abs() > 1e-9 {
+                return Err(invalid!(
+                    "the origin of swimmer {i} is not a finite displacement and a unit orientation; remove \"origins\" to measure from the state as loaded"
+                ));
+            }
+        }
+        Ok(s)
     }
 
     /// Check a scene read from a file, in open space, as the setters check their values, and put
