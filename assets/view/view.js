@@ -194,7 +194,7 @@ function fit(f) {
   const b = bounds(f);
   const centre = b.getCenter(new THREE.Vector3());
   const radius = Math.max(b.getSize(new THREE.Vector3()).length() / 2, 1);
-  const distance = radius / Math.sin((camera.fov * Math.PI) / 360) * 1.1;
+  const distance = radius / Math.sin((camera.fov * Math.PI) / 360) * 1.4;
   controls.target.copy(centre);
   camera.position.copy(centre).add(new THREE.Vector3(0.55, -0.75, 0.45).normalize().multiplyScalar(distance));
   camera.near = distance / 1000;
@@ -227,8 +227,14 @@ function addPoints(f) {
       let s = series.get(name);
       if (!s) {
         if (series.size >= MAX_PLOTS) continue;
+        if (series.size === 0) {
+          // The scene keeps clear of the plots.
+          host.style.right = "276px";
+          window.dispatchEvent(new Event("resize"));
+        }
         const canvas = document.createElement("canvas");
         canvas.width = 260; canvas.height = 96;
+        canvas.title = name;
         plotsHost.appendChild(canvas);
         s = { t: [], v: [], canvas };
         series.set(name, s);
@@ -252,7 +258,7 @@ function drawPlots() {
     c.fillText(name + " = " + fmt(last), pad, 13);
     if (s.t.length < 2) continue;
     let vmin = Math.min(...s.v), vmax = Math.max(...s.v);
-    if (vmin === vmax) { vmin -= 1e-300 + Math.abs(vmin) * 1e-9; vmax += 1e-300 + Math.abs(vmax) * 1e-9; }
+    if (vmin === vmax) { const pad = Math.abs(vmin) * 0.01 || 1; vmin -= pad; vmax += pad; }
     const t0 = s.t[0], t1 = s.t[s.t.length - 1];
     const X = (t) => pad + ((t - t0) / (t1 - t0 || 1)) * (w - 2 * pad);
     const Y = (v) => h - pad - ((v - vmin) / (vmax - vmin)) * (h - top - pad);
@@ -267,6 +273,9 @@ function drawPlots() {
 // ----- the stream ---------------------------------------------------------------------------
 const status = document.getElementById("status");
 let source = null;
+// `?frames=N`: a still picture, the stream closed after N frames (e.g. for headless screenshots).
+const stopAfter = Number(new URLSearchParams(location.search).get("frames")) || Infinity;
+let received = 0;
 
 function connect() {
   source = new EventSource("frames");
@@ -276,6 +285,11 @@ function connect() {
     try { f = JSON.parse(e.data); } catch (err) { console.error("a frame is not JSON:", err); return; }
     latest = f;
     addPoints(f);
+    received += 1;
+    if (received >= stopAfter) {
+      source.close();
+      status.textContent = "stopped after " + received + " frames (?frames=" + stopAfter + ")";
+    }
   };
   source.onerror = () => {
     // The browser reconnects by itself; a closed source is opened again. The last frame stays.

@@ -195,8 +195,15 @@ fn admit(mut stream: TcpStream, shared: &Arc<Shared>) {
     }
 }
 
+/// Answer the one request of `stream`, then close it (the server's own handle on the connection
+/// would otherwise keep it open).
 fn serve(mut stream: TcpStream, shared: &Shared) {
-    let Some(Request { method, path }) = http::read_request(&mut stream) else {
+    answer(&mut stream, shared);
+    let _ = stream.shutdown(std::net::Shutdown::Both);
+}
+
+fn answer(stream: &mut TcpStream, shared: &Shared) {
+    let Some(Request { method, path }) = http::read_request(stream) else {
         return;
     };
     let prefix = format!("/{}", shared.token);
@@ -204,42 +211,31 @@ fn serve(mut stream: TcpStream, shared: &Shared) {
         Some("") => {
             if method == "GET" {
                 let to = format!("Location: {prefix}/");
-                http::respond_with(
-                    &mut stream,
-                    "301 Moved Permanently",
-                    "text/plain",
-                    &[&to],
-                    b"",
-                );
+                http::respond_with(stream, "301 Moved Permanently", "text/plain", &[&to], b"");
             } else {
-                not_allowed(&mut stream);
+                not_allowed(stream);
             }
             return;
         }
         Some(rest) if rest.starts_with('/') => &rest[1..],
         _ => {
-            http::respond(&mut stream, "404 Not Found", "text/plain", b"not found\n");
+            http::respond(stream, "404 Not Found", "text/plain", b"not found\n");
             return;
         }
     };
     if method != "GET" {
-        not_allowed(&mut stream);
+        not_allowed(stream);
         return;
     }
     match rest {
         "frame" => match shared.slot.latest() {
-            Some(f) => http::respond(&mut stream, "200 OK", "application/json", f.as_bytes()),
-            None => http::respond(
-                &mut stream,
-                "404 Not Found",
-                "text/plain",
-                b"no frame yet\n",
-            ),
+            Some(f) => http::respond(stream, "200 OK", "application/json", f.as_bytes()),
+            None => http::respond(stream, "404 Not Found", "text/plain", b"no frame yet\n"),
         },
-        "frames" => stream_frames(&mut stream, shared),
+        "frames" => stream_frames(stream, shared),
         other => match assets::find(other) {
-            Some(a) => http::respond(&mut stream, "200 OK", a.content_type, a.body),
-            None => http::respond(&mut stream, "404 Not Found", "text/plain", b"not found\n"),
+            Some(a) => http::respond(stream, "200 OK", a.content_type, a.body),
+            None => http::respond(stream, "404 Not Found", "text/plain", b"not found\n"),
         },
     }
 }
