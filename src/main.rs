@@ -48,6 +48,9 @@ enum Command {
         /// true/false, or strings). For sweeps run as job arrays.
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
+        /// Keep the live views the script starts (s.view()) up after it ends well, until Ctrl-C.
+        #[arg(long)]
+        view: bool,
     },
     /// Run SCRIPT for every point of a parameter grid, each point in its own folder DIR/<index>/
     /// (its working directory: its files, stdout.txt, stderr.txt, status.txt there), as
@@ -244,9 +247,17 @@ fn main() -> ExitCode {
                 swimlab::script::interrupt::install_batch_handler();
                 swimlab::script::figures::make_figures(quick, out.as_deref())
             }
-            Some(Command::Run { file, quick, set }) => {
+            Some(Command::Run {
+                file,
+                quick,
+                set,
+                view,
+            }) => {
                 swimlab::script::interrupt::install_batch_handler();
-                set.iter()
+                if view {
+                    swimlab::script::view_api::keep_views();
+                }
+                let result = set.iter()
                     .map(|item| params::parse_set(item))
                     .collect::<Result<Vec<_>, String>>()
                     .map_err(|e| format!("{e}\n"))
@@ -260,7 +271,11 @@ fn main() -> ExitCode {
                                 &options,
                             ),
                         }
-                    })
+                    });
+                if view && result.is_ok() {
+                    swimlab::script::view_api::serve_until_interrupted();
+                }
+                result
             }
             None => {
                 return if swimlab::repl::run() {

@@ -625,3 +625,75 @@ fn the_page_draws_both_kinds_and_moves_in_headless_chromium() {
     let _ = child.wait();
     assert!(moved > 50, "the two pictures differ in {moved} pixels only");
 }
+
+#[test]
+fn the_shell_view_command_names_the_latest_view() {
+    use swimlab::repl::{Reply, Session};
+    let mut s = Session::new();
+    // Other tests' views may serve in this process at once: `:view` names the latest of all.
+    s.handle("let s = scene(); s.add(dumbbell());");
+    let url = match s.handle("s.view()") {
+        Reply::Output(o) => o[o.find("http://").unwrap()..]
+            .split(['"', '\n'])
+            .next()
+            .unwrap()
+            .to_string(),
+        other => panic!("{other:?}"),
+    };
+    assert!(url.starts_with("http://127.0.0.1:"), "{url}");
+    match s.handle(":view") {
+        Reply::Output(o) => assert!(o.contains("http://127.0.0.1:"), "{o}"),
+        other => panic!("{other:?}"),
+    }
+    s.handle("s.close_view();");
+    assert!(TcpStream::connect(addr_of(&url)).is_err());
+}
+
+#[test]
+fn run_with_view_keeps_the_page_up_after_the_script_until_ctrl_c() {
+    let dir = std::env::temp_dir().join(format!("swimlab-view-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("short.rhai"),
+        "let s = scene(); s.add(dumbbell()); s.view(); s.run_periods(0.5); print(\"ran\");\n",
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", "short.rhai", "--view"])
+        .current_dir(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let (mut url, mut ran) = (String::new(), String::new());
+    out.read_line(&mut url).unwrap();
+    out.read_line(&mut ran).unwrap();
+    assert_eq!(ran.trim(), "ran");
+    let mut note = String::new();
+    BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut note)
+        .unwrap();
+    assert!(note.contains("until Ctrl-C"), "{note}");
+    // The script has ended; its page and last frame are still served.
+    let (url, addr) = (url.trim(), addr_of(url.trim()));
+    let (code, body) = request(addr, "GET", &format!("{}frame", path_of(url)));
+    assert_eq!(code, 200);
+    let f: Value = serde_json::from_str(&body).unwrap();
+    assert!((f["periods"].as_f64().unwrap() - 0.5).abs() < 1e-9, "{f}");
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let started = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "--view did not stop on Ctrl-C"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(child.wait().unwrap().success());
+    assert!(TcpStream::connect(addr).is_err());
+}

@@ -47,6 +47,24 @@ pub fn keep_views() {
     lock(&KEPT).get_or_insert_with(Vec::new);
 }
 
+/// After a script run with `--view`: keep serving the views it started until Ctrl-C (nothing to
+/// wait for when it started none).
+pub fn serve_until_interrupted() {
+    let urls = live_views();
+    if urls.is_empty() {
+        console::note("--view: the script started no view (s.view()), so there is none to keep up");
+        return;
+    }
+    console::note(&format!(
+        "--view: the page stays up until Ctrl-C: {}",
+        urls.join(" ")
+    ));
+    while !interrupt::requested() {
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    lock(&KEPT).take();
+}
+
 /// The addresses of the views that serve now, oldest first.
 pub fn live_views() -> Vec<String> {
     let mut started = lock(&STARTED);
