@@ -132,6 +132,7 @@ impl From<BenchKind> for swimlab::bench::report::Kind {
             BenchKind::Ewald => Kind::Ewald,
             BenchKind::Boundaries { ewald_tol } => Kind::Boundaries { ewald_tol },
             BenchKind::Suspension => Kind::Suspension,
+            BenchKind::View => Kind::View,
         }
     }
 }
@@ -171,6 +172,10 @@ enum BenchKind {
     /// 100,000; suspension(tol)'s error against RK4 and its order; runs of 1,000 and 10,000
     /// swimmers for 1e4 periods and 100,000 for 1e3, the cost per swimmer-period.
     Suspension,
+    /// The live view's cost: 10,000 swimmers of the averaged model (--quick: 1,000) for a fixed
+    /// number of RK4 steps without a view, with a view no one reads, and with a reader that never
+    /// reads beside one that reads every frame, side by side.
+    View,
 }
 
 fn main() -> ExitCode {

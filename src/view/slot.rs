@@ -47,6 +47,11 @@ impl Slot {
         drop(old);
     }
 
+    /// How many frames were published.
+    pub fn published(&self) -> u64 {
+        self.lock().seq
+    }
+
     /// The latest frame, if any was published.
     pub fn latest(&self) -> Option<Arc<str>> {
         self.lock().frame.clone()
