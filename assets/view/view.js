@@ -194,7 +194,7 @@ function fit(f) {
   const b = bounds(f);
   const centre = b.getCenter(new THREE.Vector3());
   const radius = Math.max(b.getSize(new THREE.Vector3()).length() / 2, 1);
-  const distance = radius / Math.sin((camera.fov * Math.PI) / 360) * 1.4;
+  const distance = radius / Math.sin((camera.fov * Math.PI) / 360) * 1.15;
   controls.target.copy(centre);
   camera.position.copy(centre).add(new THREE.Vector3(0.55, -0.75, 0.45).normalize().multiplyScalar(distance));
   camera.near = distance / 1000;
