@@ -357,6 +357,21 @@ fn a_view_stops_with_its_scene_or_close_view() {
     r.unwrap();
 }
 
+#[test]
+fn changes_between_runs_show_at_once() {
+    let (scope, r) = script(
+        "let s = scene(); let url = s.view(); s.add(dumbbell()); s.box = [40e-6, 40e-6, 40e-6];",
+    );
+    r.unwrap();
+    let url = scope.get_value::<rhai::ImmutableString>("url").unwrap();
+    let (code, body) = request(addr_of(&url), "GET", &format!("{}frame", path_of(&url)));
+    assert_eq!(code, 200);
+    let f: Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(f["spheres"].as_array().unwrap().len(), 2, "{f}");
+    assert_eq!(f["box"], serde_json::json!([40e-6, 40e-6, 40e-6]));
+    assert_eq!(f["t"].as_f64(), Some(0.0));
+}
+
 #[track_caller]
 fn refused(source: &str, fragments: &[&str]) -> String {
     let (scope, r) = script(source);

@@ -130,6 +130,14 @@ impl Simulation {
         self.watcher = w;
     }
 
+    /// Show the watcher, if any, the scene as it is now: after a change between runs (a swimmer
+    /// added, a box set), which a view then draws without waiting for the next run.
+    pub fn show_watcher(&self) {
+        if let Some(w) = &self.watcher {
+            w.settled(&self.scene, &self.recorders);
+        }
+    }
+
     /// Whether a watcher watches the runs.
     pub fn watched(&self) -> bool {
         self.watcher.is_some()

@@ -136,12 +136,15 @@ impl SceneHandle {
         lift(f(&self.borrow()))
     }
 
-    /// Change the scene's settings or swimmers.
+    /// Change the scene's settings or swimmers; a live view, if any, is shown the scene after.
     pub(super) fn with_mut<T>(
         &self,
         f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
-        lift(f(self.borrow_mut()?.scene_mut()))
+        let mut sim = self.borrow_mut()?;
+        let result = f(sim.scene_mut());
+        sim.show_watcher();
+        lift(result)
     }
 
     /// Run.
@@ -156,6 +159,7 @@ impl SceneHandle {
     pub(super) fn replace(&self, trial: Scene) -> ScriptResult<INT> {
         let mut sim = self.borrow_mut()?;
         sim.replace_scene(trial);
+        sim.show_watcher();
         Ok(sim.count() as INT)
     }
 }
