@@ -496,6 +496,8 @@ fn headless(browser: &Path, dir: &Path, what: &str, url: &str) -> String {
             "--disable-background-networking",
             "--disable-component-update",
             "--disable-sync",
+            // Containers often give /dev/shm 64 MB, which Chromium outgrows.
+            "--disable-dev-shm-usage",
             "--window-size=800,600",
             "--virtual-time-budget=3000",
         ])
