@@ -4,7 +4,8 @@
 //! The stream (no browser): every frame shows the scene as it was at the frame's time, to the
 //! last bit (positions against recorder rows taken at every step), in time order, with the box
 //! or wall as set; a reader that never reads, or that goes away, neither stalls nor breaks the
-//! run, and the server stops promptly; a wrong token is a 404, anything but GET a 405. Bad input
+//! run, and the server stops promptly; a GPU run streams the device's state between its
+//! submissions; a wrong token is a 404, anything but GET a 405. Bad input
 //! to `s.view` is a clear message, and a view stops with its scene, leaving nothing listening.
 //!
 //! The page: headless Chromium (Debian's `chromium`; skipped without it unless
@@ -234,6 +235,59 @@ fn suspension(n: usize) -> Scene {
     )
     .unwrap();
     s
+}
+
+/// A GPU run (uniform steps on the device) streams frames between its submissions, each the
+/// state the device held at the frame's time: a fresh GPU run of a copy to that time agrees to
+/// rounding. Skipped without an f64-capable adapter unless `SWIMLAB_REQUIRE_GPU=1` (CI's lavapipe).
+#[test]
+fn a_gpu_run_streams_the_device_state_between_submissions() {
+    if let Err(e) = swimlab::engine::gpu::device() {
+        assert!(
+            std::env::var_os("SWIMLAB_REQUIRE_GPU").is_none_or(|v| v == "0"),
+            "SWIMLAB_REQUIRE_GPU is set but {e}"
+        );
+        eprintln!("skipped: {e}");
+        return;
+    }
+    let mut s = suspension(64);
+    s.set_backend(swimlab::engine::Backend::Gpu);
+    let period = s.period().unwrap();
+    s.set_integrator(Some(IntegratorSpec::Rk4 { dt: period / 50.0 }));
+    let start = s.clone();
+    let mut sim = Simulation::new(s);
+    // Ten periods in about two seconds.
+    let server = serve(&mut sim, Some(5.0));
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    let t_end = 10.0 * period;
+    let runner = std::thread::spawn(move || {
+        sim.run(t_end).unwrap();
+        sim
+    });
+    let frames = read_frames(addr, &path, t_end, Duration::from_secs(120));
+    let sim = runner.join().unwrap();
+    let inside: Vec<&Value> = frames
+        .iter()
+        .filter(|f| (0.0..t_end).contains(&f["t"].as_f64().unwrap()) && f["t"] != 0.0)
+        .collect();
+    assert!(inside.len() >= 3, "{} frames inside the run", inside.len());
+    let ell = Dumbbell::default().ell;
+    for f in inside.iter().step_by((inside.len() / 4).max(1)) {
+        let t = f["t"].as_f64().unwrap();
+        let mut copy = Simulation::new(start.clone());
+        copy.run(t).unwrap();
+        for i in 0..copy.count() {
+            let (x1, _) = copy.shown_spheres(i);
+            let got = vec3(&f["spheres"][2 * i]);
+            assert!(
+                (got - x1).norm() <= 1e-9 * ell,
+                "swimmer {i} at t = {t}: {got:?} streamed, {x1:?} by a run to t"
+            );
+        }
+    }
+    let last = frames.last().unwrap();
+    assert_eq!(last["t"].as_f64(), Some(sim.time()));
+    assert_eq!(vec3(&last["spheres"][0]), sim.shown_spheres(0).0);
 }
 
 #[test]

@@ -7,7 +7,7 @@
 
 use super::error::{invalid, unsupported, EngineError, Result, Setting};
 use super::gpu::support::{self, GpuSteps};
-use super::gpu::{AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
+use super::gpu::{AdaptiveSteps, GpuModel, GpuRun, Peek, RunOutcome, UniformSteps};
 use super::integrators::{uniform_steps, IntegratorSpec, StateWatch, Stepper};
 use super::model::DeviceKernel;
 use super::scene::Scene;
@@ -340,12 +340,32 @@ fn uniform_on_gpu(
         }
         let (n, h) = uniform_steps(s.time, t_end, dt);
         let t0 = s.time;
+        // A watcher looks between submissions at a copy that takes the device's state.
+        let watch = control.watch.clone();
+        let mut shadow = watch.as_ref().map(|_| s.clone());
+        let steps0 = s.stats.steps;
+        let mut peek = |t: f64, gpu: &GpuRun| {
+            let (Some(w), Some(copy)) = (&watch, shadow.as_mut()) else {
+                return;
+            };
+            if w.due() && gpu.peek_state(&mut copy.state).is_ok() {
+                copy.time = t;
+                copy.stats.steps = steps0 + ((t - t0) / h).round() as u64;
+                w.look(copy);
+            }
+            w.pace(t);
+        };
+        let peek: Option<Peek<'_>> = match watch {
+            Some(_) => Some(&mut peek),
+            None => None,
+        };
         let outcome = run.run(
             &s.swimmers,
             &s.base,
             &mut s.state,
             UniformSteps { t0, h, count: n },
             &interrupted,
+            peek,
         );
         let outcome = outcome.map_err(|e| device_failed(e, s))?;
         let done = match outcome {
