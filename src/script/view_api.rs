@@ -272,10 +272,14 @@ fn view(s: &mut SceneHandle, opts: &Map) -> ScriptResult<ImmutableString> {
 
 fn close_view(s: &mut SceneHandle) -> ScriptResult<()> {
     let mut current = s.view();
+    if current.is_none() {
+        return Ok(());
+    }
+    // Refused (the view kept whole) while a sweep shares the scene.
+    s.borrow_mut()?.set_watcher(None);
     let Some(server) = current.take() else {
         return Ok(());
     };
-    s.borrow_mut()?.set_watcher(None);
     if let Some(kept) = lock(&KEPT).as_mut() {
         kept.retain(|k| !Arc::ptr_eq(k, &server));
     }

@@ -81,9 +81,4 @@ impl Slot {
         self.lock().closed = true;
         self.changed.notify_all();
     }
-
-    /// Whether [`Slot::close`] was called.
-    pub fn closed(&self) -> bool {
-        self.lock().closed
-    }
 }
