@@ -144,6 +144,22 @@ impl RunControl {
         }))
     }
 
+    /// What a watched device run shows its state through between submissions: a copy of `s`
+    /// (made now) takes the time, the steps and, when a look is due, the device's state.
+    fn device_peek(&self, s: &Scene) -> Option<impl FnMut(f64, u64, &GpuRun)> {
+        let w = self.watch.clone()?;
+        let mut copy = s.clone();
+        let steps0 = s.stats.steps;
+        Some(move |t: f64, steps: u64, gpu: &GpuRun| {
+            if w.due() && gpu.peek_state(&mut copy.state).is_ok() {
+                copy.time = t;
+                copy.stats.steps = steps0 + steps;
+                w.look(&copy);
+            }
+            w.pace(t);
+        })
+    }
+
     /// The control of a probe run on a copy: the same interrupt, no progress and no watcher (the
     /// copy's time and state are not the run's).
     pub fn for_probe(&self) -> Self {
@@ -340,32 +356,14 @@ fn uniform_on_gpu(
         }
         let (n, h) = uniform_steps(s.time, t_end, dt);
         let t0 = s.time;
-        // A watcher looks between submissions at a copy that takes the device's state.
-        let watch = control.watch.clone();
-        let mut shadow = watch.as_ref().map(|_| s.clone());
-        let steps0 = s.stats.steps;
-        let mut peek = |t: f64, gpu: &GpuRun| {
-            let (Some(w), Some(copy)) = (&watch, shadow.as_mut()) else {
-                return;
-            };
-            if w.due() && gpu.peek_state(&mut copy.state).is_ok() {
-                copy.time = t;
-                copy.stats.steps = steps0 + ((t - t0) / h).round() as u64;
-                w.look(copy);
-            }
-            w.pace(t);
-        };
-        let peek: Option<Peek<'_>> = match watch {
-            Some(_) => Some(&mut peek),
-            None => None,
-        };
+        let mut peek = control.device_peek(s);
         let outcome = run.run(
             &s.swimmers,
             &s.base,
             &mut s.state,
             UniformSteps { t0, h, count: n },
             &interrupted,
-            peek,
+            peek.as_mut().map(|p| p as Peek<'_>),
         );
         let outcome = outcome.map_err(|e| device_failed(e, s))?;
         let done = match outcome {
@@ -421,6 +419,7 @@ fn adaptive_on_gpu(
         let Some(h) = stepper.next_step(sys.as_mut(), s.time, &s.state, &mut s.stats) else {
             break Err(invalid!("{spec} takes no adaptive steps"));
         };
+        let mut peek = control.device_peek(s);
         let report = run.run_adaptive(
             &s.swimmers,
             &s.base,
@@ -433,6 +432,7 @@ fn adaptive_on_gpu(
                 rtol,
             },
             &interrupted,
+            peek.as_mut().map(|p| p as Peek<'_>),
         );
         let report = match report {
             Ok(r) => r,

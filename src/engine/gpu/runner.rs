@@ -144,9 +144,9 @@ impl Control {
 }
 
 const NONE: u32 = u32::MAX;
-/// Shown a uniform run between submissions: the scene time reached and the run, whose state
-/// [`GpuRun::peek_state`] reads back; it decides itself whether to (a live view).
-pub type Peek<'a> = &'a mut dyn FnMut(f64, &GpuRun);
+/// Shown a run between submissions: the scene time reached, the steps the run has taken and the
+/// run, whose state [`GpuRun::peek_state`] reads back; it decides itself whether to (a live view).
+pub type Peek<'a> = &'a mut dyn FnMut(f64, u64, &GpuRun);
 
 /// Wall time one submission aims at: long enough to amortise submission, short enough for Ctrl-C.
 const TARGET_SUBMISSION_SECONDS: f64 = 0.05;
@@ -328,9 +328,7 @@ impl GpuRun {
             // A fresh step counter (u32) from a new t0 every 2^30 steps.
             let part = (steps - done).min(MAX_STEPS_PER_COUNTER);
             let t_part = t0 + done as f64 * h;
-            let this_part = peek
-                .as_mut()
-                .map(|p| &mut **p as &mut dyn FnMut(f64, &GpuRun));
+            let this_part = peek.as_mut().map(|p| &mut **p as Peek<'_>);
             match self.run_part(t_part, h, part, interrupted, this_part)? {
                 RunOutcome::Done => done += part,
                 RunOutcome::Failed { steps_done } => {
@@ -426,7 +424,7 @@ impl GpuRun {
             done += m;
             self.pace(m, elapsed);
             if let Some(p) = peek.as_deref_mut() {
-                p(t0 + done as f64 * h, self);
+                p(t0 + done as f64 * h, done, self);
             }
         }
         Ok(RunOutcome::Done)
@@ -444,7 +442,8 @@ impl GpuRun {
     /// device, so a submission holds many attempts and only the control block comes back between
     /// them. `y` comes back at the end, after a guard fired (the last accepted state) or an
     /// interrupt. Fewer than 2^30 steps are taken per call; the caller goes on from the time
-    /// reported.
+    /// reported. `peek` (a live view) is shown the run between submissions.
+    #[allow(clippy::too_many_arguments)]
     pub fn run_adaptive(
         &mut self,
         swimmers: &[Dumbbell],
@@ -453,6 +452,7 @@ impl GpuRun {
         scale: &[f64],
         steps: AdaptiveSteps,
         interrupted: &dyn Fn() -> bool,
+        mut peek: Option<Peek<'_>>,
     ) -> Result<AdaptiveReport> {
         if !self.tableau.is_adaptive() {
             return Err(invalid!("these device buffers hold a fixed-step method"));
@@ -481,6 +481,9 @@ impl GpuRun {
             }
             if interrupted() {
                 break (c, RunOutcome::Interrupted { steps_done });
+            }
+            if let Some(p) = peek.as_deref_mut() {
+                p(c.t, steps_done, self);
             }
         };
         self.read_state(y)?;
