@@ -25,9 +25,9 @@ pub type Progress = Arc<dyn Fn(f64) + Send + Sync>;
 pub type Notice = Arc<dyn Fn(&EngineError) + Send + Sync>;
 
 /// Someone who looks at the scene while a run goes on (a live view): asked after every CPU step,
-/// every device run segment and every inner step of a long step (stroboscopic averaging's direct
-/// periods) whether a look is due, which must be cheap (a view looks a few dozen times a second,
-/// not every step).
+/// every inner step of a long step (stroboscopic averaging's direct periods) and every device
+/// submission whether a look is due, which must be cheap (a view looks a few dozen times a
+/// second, not every step); a device's state is read back only for a look.
 pub trait Look: Send + Sync {
     /// Whether a look is due now.
     fn due(&self) -> bool;
@@ -38,8 +38,8 @@ pub trait Look: Send + Sync {
     fn pace(&self, time: f64);
 }
 
-/// What every run takes besides the scene: whether to stop, whom to tell the time, and whom to
-/// tell a notice (each kind once a run). The default never stops and tells no one.
+/// What every run takes besides the scene: whether to stop, whom to tell the time, whom to tell a
+/// notice (each kind once a run) and who looks. The default never stops and tells no one.
 #[derive(Clone, Default)]
 pub struct RunControl {
     interrupt: Option<Interrupt>,
