@@ -163,7 +163,8 @@ enum BenchKind {
     /// wall against the same swimmers in open space, microscopic and rigid-stroke models, 64, 100,
     /// 256 and 1,000 swimmers (--quick: 100), side by side.
     Boundaries {
-        /// The box's Ewald tolerance (default: the scene's default, 1e-10).
+        /// The box's Ewald tolerance (default: the scene's, a tenth of the default integrator's
+        /// drift tolerance).
         #[arg(long, value_name = "TOL")]
         ewald_tol: Option<f64>,
     },

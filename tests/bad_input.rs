@@ -169,6 +169,14 @@ fn every_bad_saved_scene_is_refused_at_load() {
     );
     bad_scene(|v| v["format"] = 7.into(), "format 7 is not supported");
     bad_scene(
+        |v| v["scene"]["origins"][0]["dir"] = serde_json::json!([0.0, 0.0, 0.0]),
+        "the origin of swimmer 0 is not a finite displacement and a unit orientation",
+    );
+    bad_scene(
+        |v| v["scene"]["origins"].as_array_mut().unwrap().truncate(1),
+        "2 swimmers but 1 origins",
+    );
+    bad_scene(
         |v| v["scene"]["state"].as_array_mut().unwrap().truncate(3),
         "inconsistent",
     );

@@ -72,6 +72,8 @@ fn a_sphere_in_a_cubic_box_has_hasimotos_mobility() {
     for l in [20e-6, 50e-6, 200e-6] {
         let mut s = Scene::new();
         s.set_box(Some([l; 3])).unwrap();
+        // The sums to 1e-12, below the 1e-10 the comparison with `hasimoto` asks.
+        s.set_ewald_tol(Some(1e-12)).unwrap();
         let d = Dumbbell::default();
         s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
         let f = Vector3::new(0.0, 0.0, 1e-12);
@@ -346,11 +348,67 @@ fn box_settings_are_checked_and_saved() {
     assert!(s.periodic().is_none());
     s.set_box(Some([20.0 * d.ell, 30.0 * d.ell, 25.0 * d.ell]))
         .unwrap();
-    s.set_ewald_tol(1e-9).unwrap();
+    s.set_ewald_tol(Some(1e-9)).unwrap();
     let back = Scene::from_json(&s.to_json().unwrap()).unwrap();
     assert_eq!(back.periodic(), s.periodic());
     assert_eq!(back.ewald_tol(), 1e-9);
-    assert!(s.set_ewald_tol(0.5).is_err());
+    assert!(s.set_ewald_tol(Some(0.5)).is_err());
+}
+
+/// Unless set, the Ewald tolerance follows the run's integrator: a tenth of its drift tolerance
+/// (the default auto(1.1e-5): 1.1e-6), 1e-10 for fixed steps and for the noisy defaults; the
+/// products use it (velocities equal to those at the same tolerance set by hand, unequal to
+/// 1e-10's); a set one is kept whatever the integrator and saved, and `None` follows again (saved
+/// following).
+#[test]
+fn the_ewald_tolerance_follows_the_run_unless_set() {
+    use swimlab::engine::IntegratorSpec;
+    let d = Dumbbell::default();
+    let mut s = Scene::new();
+    s.set_box(Some([8.0 * d.ell; 3])).unwrap();
+    s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
+    s.add(
+        Dumbbell { phase: 1.0, ..d },
+        Vector3::new(0.3, 2.1, -1.2) * d.ell,
+        Vector3::new(0.0, 1.0, 1.0).normalize(),
+    )
+    .unwrap();
+    // A tenth of a decimal tolerance, to the rounding of the product.
+    let near = |a: f64, b: f64| (a - b).abs() <= 1e-15 * b;
+    assert!(near(s.ewald_tol(), 1.1e-6), "{}", s.ewald_tol());
+    assert_eq!(s.ewald_tol_setting(), None);
+    let forces: Vec<_> = (0..4)
+        .map(|k| Vector3::new(1.0, -0.5 * k as f64, 0.25) * 1e-12)
+        .collect();
+    let by_default = s.sphere_velocities(&forces).unwrap();
+    let mut set = s.clone();
+    set.set_ewald_tol(Some(s.ewald_tol())).unwrap();
+    assert_eq!(set.sphere_velocities(&forces).unwrap(), by_default);
+    set.set_ewald_tol(Some(1e-10)).unwrap();
+    assert_ne!(set.sphere_velocities(&forces).unwrap(), by_default);
+    for (spec, tol) in [
+        (IntegratorSpec::rk4(1e-4).unwrap(), 1e-10),
+        (IntegratorSpec::dopri5(1e-9).unwrap(), 1e-10),
+        (IntegratorSpec::auto(1e-3).unwrap(), 1e-4),
+        (IntegratorSpec::stroboscopic(1e-6).unwrap(), 1e-7),
+    ] {
+        s.set_integrator(Some(spec));
+        assert!(near(s.ewald_tol(), tol), "{spec:?}: {}", s.ewald_tol());
+    }
+    s.set_integrator(None);
+    s.set_temperature(300.0).unwrap();
+    assert_eq!(s.ewald_tol(), 1e-10, "the noisy default steps fixed");
+    s.set_temperature(0.0).unwrap();
+    s.set_ewald_tol(Some(1e-7)).unwrap();
+    s.set_integrator(Some(IntegratorSpec::rk4(1e-4).unwrap()));
+    assert_eq!(s.ewald_tol(), 1e-7);
+    let back = Scene::from_json(&s.to_json().unwrap()).unwrap();
+    assert_eq!(back.ewald_tol_setting(), Some(1e-7));
+    s.set_ewald_tol(None).unwrap();
+    assert_eq!(s.ewald_tol(), 1e-10);
+    let json = s.to_json().unwrap();
+    assert!(!json.contains("ewald_tol"), "{json}");
+    assert_eq!(Scene::from_json(&json).unwrap().ewald_tol_setting(), None);
 }
 
 /// A microscopic pair in a box runs, and its velocities are the periodic mobility's: one step of
@@ -650,6 +708,8 @@ fn the_ewald_method_is_a_scene_setting() {
         5,
     )
     .unwrap();
+    // The sums to 1e-10 (not the default integrator's 1.1e-6): the methods are held to 1e-8.
+    s.set_ewald_tol(Some(1e-10)).unwrap();
     let forces: Vec<Vector3<f64>> = (0..60)
         .map(|_| Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5) * 1e-12)
         .collect();
@@ -741,7 +801,7 @@ fn bench_boundaries_times_every_boundary() {
     let rows = run(&[10], None).unwrap();
     assert_eq!(rows.len(), 2);
     for r in &rows {
-        for t in [r.open, r.periodic, r.wall] {
+        for t in [r.open, r.periodic, r.wall, r.wall_divergence] {
             assert!(t.is_finite() && t > 0.0, "{r:?}");
         }
     }
@@ -754,6 +814,12 @@ fn bench_boundaries_times_every_boundary() {
     let want = rows[1].periodic / rows[1].open;
     assert!((ratio(1, "box_over_open") - want).abs() <= 0.01 * want.max(1.0));
     assert_eq!(ratio(0, "open_over_micro_open"), 1.0);
+    let want = rows[1].wall_divergence / rows[0].open;
+    assert!((ratio(1, "wall_div_over_micro_open") - want).abs() <= 0.01 * want.max(1.0));
+    assert!(
+        (rows[1].ewald_tol - 1.1e-6).abs() < 1e-20,
+        "the default follows auto(1.1e-5)"
+    );
     // `--ewald-tol` out of range is refused with the range, before anything is timed.
     let e = run(&[10], Some(0.5)).unwrap_err();
     assert!(e.contains("Ewald tolerance") && e.contains("1e-2"), "{e}");
@@ -823,7 +889,7 @@ fn the_drift_error_follows_the_ewald_tolerance() {
     let settled = settle.scene().clone();
     let drift = |tol: f64| -> Vec<Vector3<f64>> {
         let mut s = settled.clone();
-        s.set_ewald_tol(tol).unwrap();
+        s.set_ewald_tol(Some(tol)).unwrap();
         let start: Vec<_> = (0..4).map(|i| s.displacement(i).unwrap()).collect();
         let mut sim = swimlab::engine::Simulation::new(s);
         sim.run_periods(1.0).unwrap();

@@ -146,9 +146,12 @@ fn run_kind(
             let rows = boundaries::run(sizes, ewald_tol)?;
             let t = boundaries::table(&rows);
             say(&format!(
-                "one right-hand side, random Fig-1 swimmers at sphere volume fraction {}, the same state in open space, a periodic box (ewald_tol {:e}) and above a wall ({} threads; medians):\n{}",
+                "one right-hand side, random Fig-1 swimmers at sphere volume fraction {}, the same state in open space, a periodic box (its sums to ewald_tol: {}) and above a wall ({} threads; medians):\n{}",
                 boundaries::PHI,
-                ewald_tol.unwrap_or(crate::engine::ewald::DEFAULT_EWALD_TOL),
+                match ewald_tol {
+                    Some(t) => format!("{t:e}, as asked"),
+                    None => "the default, a tenth of the default integrator's drift tolerance".into(),
+                },
                 rayon::current_num_threads(),
                 t.render()
             ))?;

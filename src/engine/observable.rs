@@ -4,6 +4,7 @@
 use super::advance::Probe;
 use super::error::Result;
 use super::fields::{Field, FieldKind, FieldSpec, FieldStat};
+use super::pair_correlation::{self, PairPart};
 use super::scene::Scene;
 use super::stepping::{RunControl, Workspace};
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
@@ -50,8 +51,23 @@ pub enum Observable {
     /// Mean swimming speed ⟨|V|⟩ over the swimmers (m/s): V = dR_H/dt in the averaged model, the
     /// displacement of R_H over the next period / T in the sphere models (a probe run on a copy).
     MeanSpeed,
-    /// Mean squared displacement ⟨|R_H(t) − R_H(0)|²⟩ over the swimmers since each was placed (m²).
+    /// Mean squared displacement ⟨|R_H(t) − R_H(t0)|²⟩ over the swimmers, t0 each one's origin:
+    /// its placement or the last [`Scene::reset_origins`] (m²).
     Msd,
+    /// Orientation autocorrelation of order l (1 or 2) over the swimmers since each one's origin
+    /// (as [`Observable::Msd`]): C1 = ⟨N(t)·N(t0)⟩, C2 = ⟨P2(N(t)·N(t0))⟩; free rotational
+    /// diffusion gives e^{−l(l+1) D_r t}.
+    OrientationAutocorrelation(u8),
+    /// The pair correlation of the centres in the box, one part of it ([`pair_correlation`]):
+    /// `bins` shells of equal width up to r_max.
+    PairCorrelation {
+        /// Number of shells.
+        bins: usize,
+        /// Upper end of the last shell (m), at most half the box's shortest side.
+        r_max: f64,
+        /// g, g1 or g2.
+        part: PairPart,
+    },
     /// Péclet number of the pair (i, j): the deterministic drift of its mean position over one
     /// period against the rms diffusion of that mean along one axis in the same time,
     /// |V| T / √(2 D T), with D = (D_t^i + D_t^j)/4 the mean's coefficient as rigid dumbbells.
@@ -109,6 +125,8 @@ impl Observable {
             Observable::WallAngle(i) => format!("wall_angle[{i}]"),
             Observable::MeanSpeed => "mean_speed".into(),
             Observable::Msd => "msd".into(),
+            Observable::OrientationAutocorrelation(l) => format!("C{l}"),
+            Observable::PairCorrelation { part, .. } => part.name().into(),
             Observable::Peclet(i, j) => format!("Pe[{i},{j}]"),
             Observable::PairDistances { .. } => "D_H_hist".into(),
             Observable::Field { kind, stat, .. } => format!("{}_{}", kind.name(), stat.name()),
@@ -149,7 +167,9 @@ impl Observable {
     /// Column names of the components (`R_H[0].x`, … for vectors; the name for scalars).
     pub fn columns(&self) -> Vec<String> {
         let n = self.name();
-        if let Observable::PairDistances { bins, .. } = self {
+        if let Observable::PairDistances { bins, .. } | Observable::PairCorrelation { bins, .. } =
+            self
+        {
             (0..*bins).map(|k| format!("{n}[{k}]")).collect()
         } else if self.is_vector() {
             ["x", "y", "z"].iter().map(|c| format!("{n}.{c}")).collect()
@@ -190,6 +210,8 @@ impl Observable {
             | Observable::WallGap
             | Observable::MeanSpeed
             | Observable::PairDistances { .. }
+            | Observable::OrientationAutocorrelation(_)
+            | Observable::PairCorrelation { .. }
             | Observable::Field { .. } => vec![],
         }
     }
@@ -203,6 +225,20 @@ impl Observable {
             if bins == 0 || bins > MAX_BINS || !(r_max.is_finite() && r_max > 0.0) {
                 return Err(super::error::invalid!(
                     "pair_distances(bins, r_max) needs 1 to {MAX_BINS} bins and a positive r_max in m, got {bins} and {r_max}; e.g. pair_distances(50, 100e-6)"
+                ));
+            }
+        }
+        if let Observable::PairCorrelation { bins, r_max, .. } = *self {
+            if bins == 0 || bins > MAX_BINS || !(r_max.is_finite() && r_max > 0.0) {
+                return Err(super::error::invalid!(
+                    "pair_correlation(bins, r_max) needs 1 to {MAX_BINS} shells and a positive r_max in m, got {bins} and {r_max}; e.g. pair_correlation(50, 50e-6)"
+                ));
+            }
+        }
+        if let Observable::OrientationAutocorrelation(l) = *self {
+            if !(1..=2).contains(&l) {
+                return Err(super::error::invalid!(
+                    "the orientation autocorrelation has order 1 (<N(t).N(t0)>) or 2 (<P2(N(t).N(t0))>), got {l}"
                 ));
             }
         }
@@ -230,7 +266,9 @@ impl Observable {
             Observable::Polarization | Observable::Nematic => {
                 Some("an order of the swimmers' orientations")
             }
-            Observable::MeanSpeed | Observable::Msd => Some("an average over the swimmers"),
+            Observable::MeanSpeed | Observable::Msd | Observable::OrientationAutocorrelation(_) => {
+                Some("an average over the swimmers")
+            }
             Observable::MinGap => Some("the smallest gap between two spheres of the swimmers"),
             Observable::WallGap => Some("the smallest gap between the wall and a swimmer's sphere"),
             _ => None,
@@ -324,9 +362,22 @@ impl Observable {
             Observable::Msd => {
                 let mut sum = 0.0;
                 for i in 0..s.count() {
-                    sum += s.displacement(i)?.norm_squared();
+                    sum += s.displacement_since_origin(i)?.norm_squared();
                 }
                 vec![sum / s.count().max(1) as f64]
+            }
+            Observable::OrientationAutocorrelation(l) => {
+                let mut sum = 0.0;
+                for i in 0..s.count() {
+                    let c = s.dir(i)?.dot(&s.origin(i)?.dir);
+                    sum += if l == 1 { c } else { 1.5 * c * c - 0.5 };
+                }
+                vec![sum / s.count().max(1) as f64]
+            }
+            Observable::PairCorrelation { bins, r_max, part } => {
+                pair_correlation::of_scene(s, bins, r_max)?
+                    .part(part)
+                    .to_vec()
             }
             Observable::Peclet(i, j) => vec![Self::peclet(s, i, j, probe)?],
         })

@@ -17,7 +17,7 @@ use super::error::{
     invalid, require_finite, require_positive, unsupported, EngineError, Result, Setting,
 };
 use super::ewald::{
-    Ewald, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
+    ewald_tol_for, Ewald, EwaldMethod, SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
 };
 use super::forces::{ExternalForces, Gravity};
 use super::integrators::{IntegratorSpec, OdeSystem, Reach, Stats};
@@ -31,6 +31,7 @@ use super::swimmer::{unit_direction, Dumbbell};
 use super::thermal::{NoiseRoot, Thermal};
 use super::wall::Wall;
 use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
 
 mod boundary;
 mod dynamics;
@@ -71,6 +72,8 @@ pub struct Scene {
     pub(in crate::engine) base: Vec<Vector3<f64>>,
     /// See [`super::model`]; the steppers advance it.
     pub(in crate::engine) state: Vec<f64>,
+    /// Where each swimmer's displacement and orientation are measured from.
+    origins: Vec<Origin>,
     pub(in crate::engine) time: f64,
     pub(in crate::engine) stats: Stats,
     /// Where the dynamics run.
@@ -79,12 +82,23 @@ pub struct Scene {
     thermal: Thermal,
     /// Open space, the periodic box or the wall.
     boundary: Boundary,
-    /// Tolerance of the box's Ewald sums.
-    ewald_tol: f64,
+    /// Tolerance of the box's Ewald sums; `None`: the one that serves the run's integrator
+    /// (`Scene::ewald_tol`).
+    ewald_tol: Option<f64>,
     /// How the box's mobility products are summed.
     ewald_method: EwaldMethod,
     /// External forces on the spheres.
     external: ExternalForces,
+}
+
+/// Where a swimmer's displacement and orientation are measured from (`msd()`, the orientation
+/// autocorrelation): its placement, or the last [`Scene::reset_origins`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Origin {
+    /// The displacement of R_H from its base position then (m).
+    pub displacement: Vector3<f64>,
+    /// The unit orientation N then.
+    pub dir: Vector3<f64>,
 }
 
 impl Default for Scene {
@@ -100,12 +114,13 @@ impl Default for Scene {
             swimmers: Vec::new(),
             base: Vec::new(),
             state: Vec::new(),
+            origins: Vec::new(),
             time: 0.0,
             stats: Stats::default(),
             backend: Backend::default(),
             thermal: Thermal::default(),
             boundary: Boundary::Open,
-            ewald_tol: DEFAULT_EWALD_TOL,
+            ewald_tol: None,
             ewald_method: EwaldMethod::Auto,
             external: ExternalForces::default(),
         }

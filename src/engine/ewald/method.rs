@@ -62,8 +62,22 @@ impl EwaldMethod {
     }
 }
 
-/// The default tolerance of the Ewald sums (relative to the spheres' Stokes mobility).
+/// The tolerance of the Ewald sums (relative to the spheres' Stokes mobility) where the run's
+/// integrator keeps no drift tolerance (fixed steps: euler, rk4, platen, the noisy defaults).
 pub const DEFAULT_EWALD_TOL: f64 = 1e-10;
+
+/// The Ewald tolerance a run with drift tolerance `tol` takes unless one is set: `tol` times
+/// this. A run's relative drift error is 1-5 times the sums' tolerance (the book, "What tolerance
+/// a run needs"), so a tenth keeps the sums' share of the drift error at most half the run's.
+pub const EWALD_TOL_PER_DRIFT_TOL: f64 = 0.1;
+
+/// The Ewald tolerance that serves a run keeping its drift within `drift_tol` (relative), or
+/// [`DEFAULT_EWALD_TOL`] for a run that keeps none; within the range [`check_tol`] allows.
+pub fn ewald_tol_for(drift_tol: Option<f64>) -> f64 {
+    drift_tol.map_or(DEFAULT_EWALD_TOL, |t| {
+        (t * EWALD_TOL_PER_DRIFT_TOL).clamp(1e-15, 1e-2)
+    })
+}
 
 /// The Ewald tolerance must lie in [1e-15, 1e-2].
 pub fn check_tol(tol: f64) -> Result<()> {

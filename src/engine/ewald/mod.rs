@@ -42,6 +42,7 @@ mod split;
 
 pub use beenakker::{hasimoto, Ewald};
 pub use method::{
-    check_tol, EwaldMethod, DEFAULT_EWALD_TOL, SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
+    check_tol, ewald_tol_for, EwaldMethod, DEFAULT_EWALD_TOL, EWALD_TOL_PER_DRIFT_TOL,
+    SPECTRAL_COSTLY_BELOW, SPECTRAL_FROM_SPHERES,
 };
 pub use spectral::SpectralEwald;

@@ -293,6 +293,20 @@ impl IntegratorSpec {
         self.method().takes_noise
     }
 
+    /// The tolerance relative to the drift that the method keeps (auto, stroboscopic, dopri5,
+    /// rosw); `None` for fixed steps and for `suspension(tol)`, whose tolerance is each
+    /// swimmer's own displacement's.
+    pub fn drift_tol(&self) -> Option<f64> {
+        match *self {
+            IntegratorSpec::Dopri5 { rtol } | IntegratorSpec::Rosw { rtol } => Some(rtol),
+            IntegratorSpec::Stroboscopic { tol, .. } | IntegratorSpec::Auto { tol } => Some(tol),
+            IntegratorSpec::Euler { .. }
+            | IntegratorSpec::Rk4 { .. }
+            | IntegratorSpec::Platen { .. }
+            | IntegratorSpec::Suspension { .. } => None,
+        }
+    }
+
     /// The step (s) of a fixed-step method; `None` for error-controlled ones.
     pub fn fixed_step(&self) -> Option<f64> {
         self.method().fixed_step.then(|| self.parameter())

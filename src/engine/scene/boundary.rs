@@ -127,7 +127,7 @@ impl Scene {
             mu: self.mu,
             kind: self.mobility,
             spheres: self.sphere_count(),
-            ewald_tol: self.ewald_tol,
+            ewald_tol: self.ewald_tol(),
             ewald_method: method,
         }
     }

@@ -126,6 +126,7 @@ impl Scene {
     fn truncate(&mut self, count: usize) {
         self.swimmers.truncate(count);
         self.base.truncate(count);
+        self.origins.truncate(count);
         self.state.truncate(STATE_PER_SWIMMER * count);
     }
 

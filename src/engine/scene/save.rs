@@ -37,6 +37,10 @@ struct SceneFile {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
     state: Vec<f64>,
+    /// Older files have none: the origins become the state as loaded (the displacements' origin
+    /// kept at the base positions, as `msd()` had it).
+    #[serde(default)]
+    origins: Vec<Origin>,
     time: f64,
     stats: Stats,
     /// "cpu" for files from before backends existed.
@@ -47,11 +51,9 @@ struct SceneFile {
     thermal: Thermal,
     #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
     periodic: Option<PeriodicBox>,
-    #[serde(
-        default = "default_ewald_tol",
-        skip_serializing_if = "is_default_ewald_tol"
-    )]
-    ewald_tol: f64,
+    /// Saved only when set: a scene that follows its run's integrator keeps following it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    ewald_tol: Option<f64>,
     #[serde(default, skip_serializing_if = "is_auto_ewald")]
     ewald_method: EwaldMethod,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -62,14 +64,6 @@ struct SceneFile {
 
 fn is_auto_ewald(m: &EwaldMethod) -> bool {
     *m == EwaldMethod::Auto
-}
-
-fn default_ewald_tol() -> f64 {
-    DEFAULT_EWALD_TOL
-}
-
-fn is_default_ewald_tol(t: &f64) -> bool {
-    *t == DEFAULT_EWALD_TOL
 }
 
 impl SceneFile {
@@ -86,6 +80,7 @@ impl SceneFile {
             swimmers: s.swimmers.clone(),
             base: s.base.clone(),
             state: s.state.clone(),
+            origins: s.origins.clone(),
             time: s.time,
             stats: s.stats,
             backend: s.backend,
@@ -111,6 +106,7 @@ impl SceneFile {
             swimmers: self.swimmers,
             base: self.base,
             state: self.state,
+            origins: self.origins,
             time: self.time,
             stats: self.stats,
             backend: self.backend,
@@ -170,7 +166,35 @@ impl Scene {
                 s.state.len()
             ));
         }
-        s.validate(periodic, wall)
+        // The origins after the state is checked: an old file's are read from its orientations.
+        let mut s = s.validate(periodic, wall)?;
+        if s.origins.is_empty() {
+            s.origins = (0..n)
+                .map(|i| Origin {
+                    displacement: Vector3::zeros(),
+                    dir: vec3(&s.state, STATE_PER_SWIMMER * i + 3).normalize(),
+                })
+                .collect();
+        }
+        if s.origins.len() != n {
+            return Err(invalid!(
+                "scene file is inconsistent: {n} swimmers but {} origins; remove \"origins\" to measure from the state as loaded",
+                s.origins.len()
+            ));
+        }
+        for (i, o) in s.origins.iter().enumerate() {
+            let finite = o
+                .displacement
+                .iter()
+                .chain(o.dir.iter())
+                .all(|x| x.is_finite());
+            if !finite || (o.dir.norm() - 1.0).abs() > 1e-9 {
+                return Err(invalid!(
+                    "the origin of swimmer {i} is not a finite displacement and a unit orientation; remove \"origins\" to measure from the state as loaded"
+                ));
+            }
+        }
+        Ok(s)
     }
 
     /// Check a scene read from a file, in open space, as the setters check their values, and put
@@ -185,7 +209,9 @@ impl Scene {
             Steric::new(st.range, st.stiffness)?;
         }
         self.thermal.validate()?;
-        crate::engine::ewald::check_tol(self.ewald_tol)?;
+        if let Some(t) = self.ewald_tol {
+            crate::engine::ewald::check_tol(t)?;
+        }
         if let Some(b) = periodic {
             let mut probe = Scene::new();
             probe.set_box(Some(b.sides()))?;

@@ -97,14 +97,25 @@ impl Scene {
         Ok(())
     }
 
-    /// Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility.
+    /// Tolerance of the box's Ewald sums, relative to a sphere's Stokes mobility: the one set,
+    /// or else the one that serves the run's integrator ([`ewald_tol_for`] its drift
+    /// tolerance: a tenth of it, and [`crate::engine::ewald::DEFAULT_EWALD_TOL`] for fixed steps).
     pub fn ewald_tol(&self) -> f64 {
+        self.ewald_tol
+            .unwrap_or_else(|| ewald_tol_for(self.integrator().drift_tol()))
+    }
+
+    /// The Ewald tolerance set on this scene; `None` when it follows the run's integrator.
+    pub fn ewald_tol_setting(&self) -> Option<f64> {
         self.ewald_tol
     }
 
-    /// Set the tolerance of the box's Ewald sums (1e-15 to 1e-2).
-    pub fn set_ewald_tol(&mut self, tol: f64) -> Result<()> {
-        crate::engine::ewald::check_tol(tol)?;
+    /// Set the tolerance of the box's Ewald sums (1e-15 to 1e-2), or `None` to follow the
+    /// run's integrator again.
+    pub fn set_ewald_tol(&mut self, tol: Option<f64>) -> Result<()> {
+        if let Some(t) = tol {
+            crate::engine::ewald::check_tol(t)?;
+        }
         self.ewald_tol = tol;
         Ok(())
     }

@@ -19,7 +19,35 @@ impl Scene {
         let v = self.swimmer_model().initial_vector(&n, len);
         self.state
             .extend_from_slice(&[0.0, 0.0, 0.0, v.x, v.y, v.z]);
+        self.origins.push(Origin {
+            displacement: Vector3::zeros(),
+            dir: v.normalize(),
+        });
         self.swimmers.len() - 1
+    }
+
+    /// Where swimmer `i`'s displacement and orientation are measured from: its placement, or the
+    /// last [`Scene::reset_origins`].
+    pub fn origin(&self, i: usize) -> Result<Origin> {
+        self.check_index(i)?;
+        Ok(self.origins[i])
+    }
+
+    /// Measure every swimmer's displacement (`msd()`) and orientation autocorrelation from its
+    /// state now, as if all were placed now: a run's transient left out of what is measured.
+    pub fn reset_origins(&mut self) {
+        for i in 0..self.count() {
+            let k = STATE_PER_SWIMMER * i;
+            self.origins[i] = Origin {
+                displacement: vec3(&self.state, k),
+                dir: vec3(&self.state, k + 3).normalize(),
+            };
+        }
+    }
+
+    /// Displacement of R_H of swimmer `i` since its origin ([`Scene::origin`]) (m).
+    pub fn displacement_since_origin(&self, i: usize) -> Result<Vector3<f64>> {
+        Ok(self.displacement(i)? - self.origins[i].displacement)
     }
 
     /// The length at which swimmer `d`'s spheres sit now: L(t), or ℓ in the averaged model, whose
