@@ -48,6 +48,9 @@ enum Command {
         /// true/false, or strings). For sweeps run as job arrays.
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
+        /// Keep the live views the script starts (s.view()) up after it ends well, until Ctrl-C.
+        #[arg(long)]
+        view: bool,
     },
     /// Run SCRIPT for every point of a parameter grid, each point in its own folder DIR/<index>/
     /// (its working directory: its files, stdout.txt, stderr.txt, status.txt there), as
@@ -129,6 +132,7 @@ impl From<BenchKind> for swimlab::bench::report::Kind {
             BenchKind::Ewald => Kind::Ewald,
             BenchKind::Boundaries { ewald_tol } => Kind::Boundaries { ewald_tol },
             BenchKind::Suspension => Kind::Suspension,
+            BenchKind::View => Kind::View,
         }
     }
 }
@@ -169,6 +173,10 @@ enum BenchKind {
     /// 100,000; suspension(tol)'s error against RK4 and its order; runs of 1,000 and 10,000
     /// swimmers for 1e4 periods and 100,000 for 1e3, the cost per swimmer-period.
     Suspension,
+    /// The live view's cost: 10,000 swimmers of the averaged model (--quick: 1,000) for a fixed
+    /// number of RK4 steps without a view, with a view no one reads, and with a reader that never
+    /// reads beside one that reads every frame, side by side.
+    View,
 }
 
 fn main() -> ExitCode {
@@ -245,9 +253,17 @@ fn main() -> ExitCode {
                 swimlab::script::interrupt::install_batch_handler();
                 swimlab::script::figures::make_figures(quick, out.as_deref())
             }
-            Some(Command::Run { file, quick, set }) => {
+            Some(Command::Run {
+                file,
+                quick,
+                set,
+                view,
+            }) => {
                 swimlab::script::interrupt::install_batch_handler();
-                set.iter()
+                if view {
+                    swimlab::script::view_api::keep_views();
+                }
+                let result = set.iter()
                     .map(|item| params::parse_set(item))
                     .collect::<Result<Vec<_>, String>>()
                     .map_err(|e| format!("{e}\n"))
@@ -261,7 +277,11 @@ fn main() -> ExitCode {
                                 &options,
                             ),
                         }
-                    })
+                    });
+                if view && result.is_ok() {
+                    swimlab::script::view_api::serve_until_interrupted();
+                }
+                result
             }
             None => {
                 return if swimlab::repl::run() {

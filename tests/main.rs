@@ -44,5 +44,6 @@ mod suspensions;
 mod sweeps;
 mod thermal;
 mod trajectories;
+mod view;
 mod viewers;
 mod walls;

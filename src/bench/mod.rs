@@ -4,6 +4,7 @@
 pub mod backends;
 pub mod boundaries;
 pub mod ewald;
+pub mod live_view;
 pub mod pairs;
 pub mod plots;
 pub mod report;

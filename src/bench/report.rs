@@ -2,7 +2,8 @@
 //! under out/bench/. The command line only names the benchmark.
 
 use super::{
-    backends, boundaries, ewald, pairs, plots, scaling, stability, suspension, work_precision,
+    backends, boundaries, ewald, live_view, pairs, plots, scaling, stability, suspension,
+    work_precision,
 };
 use crate::engine::Model;
 
@@ -28,6 +29,8 @@ pub enum Kind {
     },
     /// Bulk suspensions of the averaged model: right-hand side, placement, long runs, accuracy.
     Suspension,
+    /// A run with and without a live view attached (and with readers that never read).
+    View,
 }
 
 /// Run one benchmark, tell `say` its tables line by line (the command line prints them) and
@@ -188,6 +191,27 @@ fn run_kind(
             say("\nCSV written to out/bench/scaling.csv")?;
         }
         Kind::Suspension => run_suspension(quick, say)?,
+        Kind::View => {
+            let (n, steps, rounds) = if quick {
+                (1000, 20, 1)
+            } else {
+                (10_000, 100, 3)
+            };
+            let t = live_view::run(n, steps, rounds).map_err(|e| e.to_string())?;
+            say(&format!(
+                "\n{n} swimmers (averaged model, box at phi = 0.1%, cutoff), {steps} RK4 steps of T/20, median of {rounds} rounds; frames at most 30 a second:\n{}",
+                t.render()
+            ))?;
+            let (secs, bytes) = live_view::encoding(n).map_err(|e| e.to_string())?;
+            say(&format!(
+                "encoding one frame of {n} swimmers: {:.2} ms, {:.2} MB",
+                secs * 1e3,
+                bytes as f64 / 1e6
+            ))?;
+            t.write_csv(std::path::Path::new("out/bench/view.csv"))
+                .map_err(io)?;
+            say("\nCSV written to out/bench/view.csv")?;
+        }
         Kind::Backends => {
             match crate::engine::gpu::device() {
                 Ok(d) => say(&format!("GPU adapter: {}", d.describe()))?,

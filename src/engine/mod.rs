@@ -62,6 +62,6 @@ pub use model::{Coefficients, Model};
 pub use observable::Observable;
 pub use recorder::{Recorder, Trigger};
 pub use scene::{Scene, DEFAULT_AUTO_TOL};
-pub use simulation::Simulation;
-pub use stepping::RunControl;
+pub use simulation::{Simulation, Watcher};
+pub use stepping::{Look, RunControl};
 pub use swimmer::Dumbbell;

@@ -11,13 +11,23 @@ use super::observable::Observable;
 use super::plan;
 use super::recorder::{Recorder, Trigger};
 use super::scene::Scene;
-use super::stepping::{Interrupt, Notice, Progress, RunControl, Workspace};
+use super::stepping::{Interrupt, Look, Notice, Progress, RunControl, Workspace};
 use nalgebra::Vector3;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
+/// Someone who watches a simulation as it runs (a live view): a [`Look`] at the scene between
+/// steps, and told of the recorders' rows and of the runs' ends.
+pub trait Watcher: Look {
+    /// The recorders took rows (a run reached one's due time).
+    fn recorded(&self, recorders: &[Recorder]);
+    /// The watcher was just attached, or a run begins or ends (however it ends): the scene and
+    /// the recorders as they are now, worth a look whatever the rate.
+    fn settled(&self, scene: &Scene, recorders: &[Recorder]);
+}
+
 /// A scene and what runs it. See the [module docs](self).
-#[derive(Debug, Default)]
+#[derive(Default)]
 pub struct Simulation {
     scene: Scene,
     recorders: Vec<Recorder>,
@@ -26,6 +36,21 @@ pub struct Simulation {
     control: RunControl,
     /// Whether this simulation is being replaced: its recorders' files may be taken over.
     retiring: Arc<AtomicBool>,
+    watcher: Option<Arc<dyn Watcher>>,
+}
+
+impl std::fmt::Debug for Simulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Simulation")
+            .field("scene", &self.scene)
+            .field("recorders", &self.recorders)
+            .field("workspace", &self.workspace)
+            .field("probes", &self.probes)
+            .field("control", &self.control)
+            .field("retiring", &self.retiring)
+            .field("watcher", &self.watcher.is_some())
+            .finish()
+    }
 }
 
 impl std::ops::Deref for Simulation {
@@ -94,6 +119,30 @@ impl Simulation {
         self.control.set_notice(n);
     }
 
+    /// Let `w` watch the runs (`None`: no one): it is shown the scene now, and then as runs go.
+    /// A simulation has one watcher; a new one replaces it.
+    pub fn set_watcher(&mut self, w: Option<Arc<dyn Watcher>>) {
+        self.control
+            .set_watch(w.clone().map(|w| w as Arc<dyn Look>));
+        if let Some(w) = &w {
+            w.settled(&self.scene, &self.recorders);
+        }
+        self.watcher = w;
+    }
+
+    /// Show the watcher, if any, the scene as it is now: after a change between runs (a swimmer
+    /// added, a box set), which a view then draws without waiting for the next run.
+    pub fn show_watcher(&self) {
+        if let Some(w) = &self.watcher {
+            w.settled(&self.scene, &self.recorders);
+        }
+    }
+
+    /// Whether a watcher watches the runs.
+    pub fn watched(&self) -> bool {
+        self.watcher.is_some()
+    }
+
     // ----- running -------------------------------------------------------------------------
 
     /// Advance the scene by `duration` seconds. Equivalent to:
@@ -112,8 +161,19 @@ impl Simulation {
     /// Recorders also take a row at the end of the run if their trigger is "at end". Rows taken
     /// before an error or interrupt are kept. A run whose cost will be far beyond what its length
     /// suggests says so when it starts (a notice, [`Scene::cost_notices`]), and so does stroboscopic
-    /// averaging when it falls back to direct integration.
+    /// averaging when it falls back to direct integration. A [`Watcher`] is shown the scene when
+    /// the run begins, after every step, when recorders take rows, and when the run ends.
     pub fn run(&mut self, duration: f64) -> Result<()> {
+        let Some(w) = self.watcher.clone() else {
+            return self.run_unwatched(duration);
+        };
+        w.settled(&self.scene, &self.recorders);
+        let outcome = self.run_unwatched(duration);
+        w.settled(&self.scene, &self.recorders);
+        outcome
+    }
+
+    fn run_unwatched(&mut self, duration: f64) -> Result<()> {
         require_finite("duration", duration)?;
         if duration < 0.0 {
             return Err(invalid!(
@@ -176,9 +236,14 @@ impl Simulation {
 
     fn fire_recorders(&mut self, end_of_run: bool) -> Result<()> {
         let mut probe = Probe::new(&mut self.probes, &self.control);
-        self.recorders
+        let fired = self
+            .recorders
             .iter_mut()
-            .try_for_each(|r| r.fire(&self.scene, end_of_run, &mut probe))
+            .try_for_each(|r| r.fire(&self.scene, end_of_run, &mut probe));
+        if let Some(w) = &self.watcher {
+            w.recorded(&self.recorders);
+        }
+        fired
     }
 
     /// What the integrator in use runs on this scene ([`Scene::integrator_info`]), and what the

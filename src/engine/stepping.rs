@@ -7,8 +7,8 @@
 
 use super::error::{invalid, unsupported, EngineError, Result, Setting};
 use super::gpu::support::{self, GpuSteps};
-use super::gpu::{AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
-use super::integrators::{uniform_steps, IntegratorSpec, Stepper};
+use super::gpu::{AdaptiveSteps, GpuModel, GpuRun, Peek, RunOutcome, UniformSteps};
+use super::integrators::{uniform_steps, IntegratorSpec, StateWatch, Stepper};
 use super::model::DeviceKernel;
 use super::scene::Scene;
 use std::sync::Arc;
@@ -24,13 +24,28 @@ pub type Progress = Arc<dyn Fn(f64) + Send + Sync>;
 /// and why. The payload is an [`EngineError`] for its message and fixes; the run goes on.
 pub type Notice = Arc<dyn Fn(&EngineError) + Send + Sync>;
 
-/// What every run takes besides the scene: whether to stop, whom to tell the time, and whom to
-/// tell a notice (each kind once a run). The default never stops and tells no one.
+/// Someone who looks at the scene while a run goes on (a live view): asked after every CPU step,
+/// every inner step of a long step (stroboscopic averaging's direct periods) and every device
+/// submission whether a look is due, which must be cheap (a view looks a few dozen times a
+/// second, not every step); a device's state is read back only for a look.
+pub trait Look: Send + Sync {
+    /// Whether a look is due now.
+    fn due(&self) -> bool;
+    /// Look at the scene (after `due` said so).
+    fn look(&self, s: &Scene);
+    /// The run reached scene time `time`: hold it back (sleep) if it goes faster than it is
+    /// watched.
+    fn pace(&self, time: f64);
+}
+
+/// What every run takes besides the scene: whether to stop, whom to tell the time, whom to tell a
+/// notice (each kind once a run) and who looks. The default never stops and tells no one.
 #[derive(Clone, Default)]
 pub struct RunControl {
     interrupt: Option<Interrupt>,
     progress: Option<Progress>,
     notice: Option<Notice>,
+    watch: Option<Arc<dyn Look>>,
     /// The kinds of notice given since the run began.
     noticed: Arc<std::sync::Mutex<Vec<&'static str>>>,
 }
@@ -41,6 +56,7 @@ impl std::fmt::Debug for RunControl {
             .field("interrupt", &self.interrupt.is_some())
             .field("progress", &self.progress.is_some())
             .field("notice", &self.notice.is_some())
+            .field("watch", &self.watch.is_some())
             .finish()
     }
 }
@@ -59,6 +75,11 @@ impl RunControl {
     /// Tell `n` a run's notices (`None`: no one).
     pub fn set_notice(&mut self, n: Option<Notice>) {
         self.notice = n;
+    }
+
+    /// Show `w` the scene as runs go (`None`: no one looks).
+    pub fn set_watch(&mut self, w: Option<Arc<dyn Look>>) {
+        self.watch = w;
     }
 
     /// A run begins: every kind of notice may be given again.
@@ -95,13 +116,58 @@ impl RunControl {
         }
     }
 
-    /// The control of a probe run on a copy: the same interrupt, no progress (the copy's time is
-    /// not the run's).
+    /// Show the watcher, if any, the scene as it is after a step, if a look is due.
+    pub fn look(&self, s: &Scene) {
+        if let Some(w) = &self.watch {
+            if w.due() {
+                w.look(s);
+            }
+            w.pace(s.time);
+        }
+    }
+
+    /// The watch a stepper whose steps hold many inner steps shows the state inside them: a
+    /// copy of `s` (made now) takes the inner step's time and state when a look is due.
+    fn inner_watch(&self, s: &Scene) -> Option<StateWatch> {
+        let w = self.watch.clone()?;
+        let shadow = std::sync::Mutex::new(s.clone());
+        Some(Arc::new(move |t: f64, y: &[f64]| {
+            if w.due() {
+                let mut copy = shadow.lock().unwrap_or_else(|e| e.into_inner());
+                if copy.state.len() == y.len() {
+                    copy.time = t;
+                    copy.state.copy_from_slice(y);
+                    w.look(&copy);
+                }
+            }
+            w.pace(t);
+        }))
+    }
+
+    /// What a watched device run shows its state through between submissions: a copy of `s`
+    /// (made now) takes the time, the steps and, when a look is due, the device's state.
+    fn device_peek(&self, s: &Scene) -> Option<impl FnMut(f64, u64, &GpuRun)> {
+        let w = self.watch.clone()?;
+        let mut copy = s.clone();
+        let steps0 = s.stats.steps;
+        Some(move |t: f64, steps: u64, gpu: &GpuRun| {
+            if w.due() && gpu.peek_state(&mut copy.state).is_ok() {
+                copy.time = t;
+                copy.stats.steps = steps0 + steps;
+                w.look(&copy);
+            }
+            w.pace(t);
+        })
+    }
+
+    /// The control of a probe run on a copy: the same interrupt, no progress and no watcher (the
+    /// copy's time and state are not the run's).
     pub fn for_probe(&self) -> Self {
         RunControl {
             interrupt: self.interrupt.clone(),
             progress: None,
             notice: None,
+            watch: None,
             noticed: Arc::default(),
         }
     }
@@ -174,6 +240,9 @@ pub fn advance_cpu(
     let key = s.stepper_key(spec);
     let mut stepper = ws.take_stepper(s, spec, &key)?;
     stepper.set_interrupt(control.interrupt.clone());
+    if stepper.watches_inside() {
+        stepper.set_watch(control.inner_watch(s));
+    }
     let mut outcome = Ok(());
     let mut taken = 0;
     let fallbacks = s.stats.direct_fallbacks;
@@ -187,6 +256,7 @@ pub fn advance_cpu(
             Ok(t) => {
                 s.time = t;
                 control.report(s.time);
+                control.look(s);
                 if s.stats.direct_fallbacks > fallbacks {
                     if let Some(why) = stepper.report() {
                         control.notice(
@@ -215,6 +285,8 @@ pub fn advance_cpu(
             }
         }
     }
+    // The copy the watch holds is let go.
+    stepper.set_watch(None);
     ws.stepper = Some((spec, key, stepper));
     outcome
 }
@@ -284,12 +356,14 @@ fn uniform_on_gpu(
         }
         let (n, h) = uniform_steps(s.time, t_end, dt);
         let t0 = s.time;
+        let mut peek = control.device_peek(s);
         let outcome = run.run(
             &s.swimmers,
             &s.base,
             &mut s.state,
             UniformSteps { t0, h, count: n },
             &interrupted,
+            peek.as_mut().map(|p| p as Peek<'_>),
         );
         let outcome = outcome.map_err(|e| device_failed(e, s))?;
         let done = match outcome {
@@ -306,6 +380,7 @@ fn uniform_on_gpu(
         s.stats.steps += done;
         s.stats.rhs_evals += done * stages + 1;
         control.report(s.time);
+        control.look(s);
         match outcome {
             RunOutcome::Interrupted { .. } => {
                 return Err(EngineError::Interrupted { time: s.time })
@@ -344,6 +419,7 @@ fn adaptive_on_gpu(
         let Some(h) = stepper.next_step(sys.as_mut(), s.time, &s.state, &mut s.stats) else {
             break Err(invalid!("{spec} takes no adaptive steps"));
         };
+        let mut peek = control.device_peek(s);
         let report = run.run_adaptive(
             &s.swimmers,
             &s.base,
@@ -356,6 +432,7 @@ fn adaptive_on_gpu(
                 rtol,
             },
             &interrupted,
+            peek.as_mut().map(|p| p as Peek<'_>),
         );
         let report = match report {
             Ok(r) => r,
@@ -367,6 +444,7 @@ fn adaptive_on_gpu(
         s.stats.rhs_evals += stages * (report.steps + report.rejected) + 1;
         stepper.continue_with_step(report.h);
         control.report(s.time);
+        control.look(s);
         match report.outcome {
             RunOutcome::Interrupted { .. } => break Err(EngineError::Interrupted { time: s.time }),
             RunOutcome::Failed { .. } => {

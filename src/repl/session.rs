@@ -77,9 +77,39 @@ pub(super) const COMMANDS: &[(&str, &str)] = &[
         ":history [N]",
         "list this session's inputs (the last N)",
     ),
+    (
+        ":view",
+        "open the latest live view (s.view()) in the default browser, or print its address where none opens",
+    ),
     (":clear", "forget all variables and functions"),
     (":quit", "leave (Ctrl-D does too)"),
 ];
+
+/// `:view`: the latest live view opened with `xdg-open` where a desktop has one, else its
+/// address to open by hand.
+fn open_view() -> Reply {
+    let Some(url) = script::view_api::live_views().pop() else {
+        return Reply::Error(
+            "no live view is served; start one with s.view() (s being a scene)".into(),
+        );
+    };
+    let desktop = ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|x| !x.is_empty()));
+    let opened = desktop
+        && std::process::Command::new("xdg-open")
+            .arg(&url)
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .is_ok();
+    Reply::Output(if opened {
+        format!("opened {url} in the default browser")
+    } else {
+        format!("{url}\n(no browser opens from here: open that address in one)")
+    })
+}
 
 impl Session {
     /// A fresh session.
@@ -372,6 +402,7 @@ impl Session {
                     )),
                 },
             },
+            "view" => open_view(),
             "clear" => {
                 self.scope.clear();
                 self.functions = AST::empty();

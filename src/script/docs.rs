@@ -44,6 +44,7 @@ pub static DOCS: LazyLock<Vec<Doc>> = LazyLock::new(|| {
         super::params::DOCS,
         super::csv_api::DOCS,
         super::util_api::DOCS,
+        super::view_api::DOCS,
     ]
     .concat();
     all.sort_by_key(|d| GROUPS.iter().position(|g| *g == d.group));

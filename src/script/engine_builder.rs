@@ -5,7 +5,7 @@ use super::{
     collective_api, continuum_api, csv_api, dumbbell_api, field_api, float_cmp, integrator_api,
     interrupt, limits, observable_api, panic_guard::guard, params, picture_api, plot_api,
     render_error, scene_api, scene_settings_api, signatures, stdlib, sweep_api, types, util_api,
-    wall_api, wrong_calls,
+    view_api, wall_api, wrong_calls,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -47,6 +47,7 @@ pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModu
     picture_api::register(&mut engine);
     field_api::register(&mut engine);
     continuum_api::register(&mut engine);
+    view_api::register(&mut engine);
     params::register_defaults(&mut engine);
     let embedded = stdlib::install(&mut engine);
     // `print` as every other text a script writes: a closed standard output ends the process

@@ -32,6 +32,7 @@ pub mod stdlib;
 mod sweep_api;
 mod types;
 mod util_api;
+pub mod view_api;
 mod wall_api;
 mod wrong_calls;
 

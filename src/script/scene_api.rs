@@ -10,9 +10,10 @@ use super::doc::{self, doc_entry, Doc};
 use super::dumbbell_api::DumbbellSpec;
 use super::interrupt;
 use crate::engine::{Backend, Scene, Simulation};
+use crate::view::Server;
 use rhai::{Array, Dynamic, Engine, INT};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::sync::{Arc, Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 /// The largest scene file `load_scene` reads (bytes): a saved scene of 10^5 swimmers is ~60 MB.
 pub const MAX_SCENE_FILE_BYTES: u64 = 256 << 20;
@@ -23,6 +24,8 @@ pub struct SceneHandle {
     sim: Arc<RwLock<Simulation>>,
     /// The sweeps whose calls share this scene now: while any does, it can be read, not changed.
     shared_by_sweeps: SweepCount,
+    /// The live view of this scene, if one is served (`s.view()`): it stops with the last handle.
+    view: Arc<Mutex<Option<Arc<Server>>>>,
 }
 
 /// How many sweeps' calls share a script value now (a scene, a continuum): they run at once on
@@ -82,12 +85,18 @@ impl SceneHandle {
         SceneHandle {
             sim: Arc::new(RwLock::new(sim)),
             shared_by_sweeps: SweepCount::default(),
+            view: Arc::default(),
         }
     }
 
     /// Whether `other` is a handle on the same scene.
     pub(super) fn same(&self, other: &SceneHandle) -> bool {
         Arc::ptr_eq(&self.sim, &other.sim)
+    }
+
+    /// The scene's live view, if one is served.
+    pub(super) fn view(&self) -> std::sync::MutexGuard<'_, Option<Arc<Server>>> {
+        self.view.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     /// The count of sweeps sharing this scene.
@@ -127,12 +136,15 @@ impl SceneHandle {
         lift(f(&self.borrow()))
     }
 
-    /// Change the scene's settings or swimmers.
+    /// Change the scene's settings or swimmers; a live view, if any, is shown the scene after.
     pub(super) fn with_mut<T>(
         &self,
         f: impl FnOnce(&mut Scene) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
-        lift(f(self.borrow_mut()?.scene_mut()))
+        let mut sim = self.borrow_mut()?;
+        let result = f(sim.scene_mut());
+        sim.show_watcher();
+        lift(result)
     }
 
     /// Run.
@@ -147,6 +159,7 @@ impl SceneHandle {
     pub(super) fn replace(&self, trial: Scene) -> ScriptResult<INT> {
         let mut sim = self.borrow_mut()?;
         sim.replace_scene(trial);
+        sim.show_watcher();
         Ok(sim.count() as INT)
     }
 }

@@ -211,6 +211,12 @@ const CALLS: &[&str] = &[
     "b.animate(P, #{ frames: 2, periods: V })",
     "display(V)",
     "tplot(V)",
+    // The live view.
+    "s.view()",
+    "s.view(V)",
+    "b.view(#{ port: V, every: V, pace: V, fields: V })",
+    "s.close_view()",
+    "b.close_view()",
     "r.plot(P, \"time\", V)",
     "r.plot(\"time\", V)",
     // Sweeps.

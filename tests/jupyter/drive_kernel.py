@@ -100,6 +100,9 @@ try:
     check("display(value) shows pictures and values mid-cell", len(shown) == 3 and "image/png" in shown[1]["data"] and shown[2]["data"]["text/plain"] == "1.5" and of_type(out, "execute_result"), [m["msg_type"] for m in out])
     reply, out = run(kc, "s.snapshot()")
     check("a snapshot is shown", of_type(out, "display_data"), [m["msg_type"] for m in out])
+    reply, out = run(kc, "let w = scene(); w.add(dumbbell()); let url = w.view(); w.run_periods(0.2); w.close_view(); url")
+    html = [d["data"].get("text/html", "") for d in of_type(out, "display_data")]
+    check("a view shows its page inline", reply["status"] == "ok" and any("<iframe" in h and "http://127.0.0.1:" in h for h in html), [m["msg_type"] for m in out])
 
     reply, out = run(kc, "let x = 1;\nx.nope()")
     err = of_type(out, "error")

@@ -21,6 +21,7 @@ EXPECT = {
     "scallop.ipynb": (2, [r"the scallop theorem holds: no net motion"]),
     "two_swimmers.ipynb": (2, [r"largest departure from the sine: \d\.\d+e-[3-9]\b", r"in phase: -?\d\.\d+e-1\d, antiphase: -?\d\.\d+e-1\d"]),
     "averaged_vs_micro.ipynb": (1, [r"the averaged model improves with distance", r"microscopic [\d.]+ ms, averaged [\d.]+ ms"]),
+    "watch_a_pair.ipynb": (1, [r"http://127\.0\.0\.1:\d+/[0-9a-f]{32}/", r"collective drift per period: -?\d\.\d+e-\d+ ell"]),
 }
 
 

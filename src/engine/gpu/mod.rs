@@ -30,4 +30,4 @@ pub mod support;
 pub use common::WORKGROUP;
 pub use device::{available, device, quiet_device_selection, GpuDevice};
 pub use kernels::Kernels;
-pub use runner::{AdaptiveReport, AdaptiveSteps, GpuModel, GpuRun, RunOutcome, UniformSteps};
+pub use runner::{AdaptiveReport, AdaptiveSteps, GpuModel, GpuRun, Peek, RunOutcome, UniformSteps};

@@ -144,6 +144,10 @@ impl Control {
 }
 
 const NONE: u32 = u32::MAX;
+/// Shown a run between submissions: the scene time reached, the steps the run has taken and the
+/// run, whose state [`GpuRun::peek_state`] reads back; it decides itself whether to (a live view).
+pub type Peek<'a> = &'a mut dyn FnMut(f64, u64, &GpuRun);
+
 /// Wall time one submission aims at: long enough to amortise submission, short enough for Ctrl-C.
 const TARGET_SUBMISSION_SECONDS: f64 = 0.05;
 /// At most this many steps per submission (bounds the command buffer's size).
@@ -302,7 +306,7 @@ impl GpuRun {
     /// Take `steps` uniform steps of size `h` from (t0, y): the state goes up, the steps run on the
     /// device in submissions of many steps, and `y` comes back once at the end (also after a guard
     /// fired or an interrupt, holding the last good state). `interrupted` is polled between
-    /// submissions.
+    /// submissions, and `peek` (a live view) is shown the run after each.
     pub fn run(
         &mut self,
         swimmers: &[Dumbbell],
@@ -310,6 +314,7 @@ impl GpuRun {
         y: &mut [f64],
         steps: UniformSteps,
         interrupted: &dyn Fn() -> bool,
+        mut peek: Option<Peek<'_>>,
     ) -> Result<RunOutcome> {
         let UniformSteps {
             t0,
@@ -323,7 +328,8 @@ impl GpuRun {
             // A fresh step counter (u32) from a new t0 every 2^30 steps.
             let part = (steps - done).min(MAX_STEPS_PER_COUNTER);
             let t_part = t0 + done as f64 * h;
-            match self.run_part(t_part, h, part, interrupted)? {
+            let this_part = peek.as_mut().map(|p| &mut **p as Peek<'_>);
+            match self.run_part(t_part, h, part, interrupted, this_part)? {
                 RunOutcome::Done => done += part,
                 RunOutcome::Failed { steps_done } => {
                     outcome = RunOutcome::Failed {
@@ -391,6 +397,7 @@ impl GpuRun {
         h: f64,
         steps: u64,
         interrupted: &dyn Fn() -> bool,
+        mut peek: Option<Peek<'_>>,
     ) -> Result<RunOutcome> {
         let params = self.params(t0, h, 0.0);
         let q = &self.dev.queue;
@@ -416,6 +423,9 @@ impl GpuRun {
             }
             done += m;
             self.pace(m, elapsed);
+            if let Some(p) = peek.as_deref_mut() {
+                p(t0 + done as f64 * h, done, self);
+            }
         }
         Ok(RunOutcome::Done)
     }
@@ -432,7 +442,8 @@ impl GpuRun {
     /// device, so a submission holds many attempts and only the control block comes back between
     /// them. `y` comes back at the end, after a guard fired (the last accepted state) or an
     /// interrupt. Fewer than 2^30 steps are taken per call; the caller goes on from the time
-    /// reported.
+    /// reported. `peek` (a live view) is shown the run between submissions.
+    #[allow(clippy::too_many_arguments)]
     pub fn run_adaptive(
         &mut self,
         swimmers: &[Dumbbell],
@@ -441,6 +452,7 @@ impl GpuRun {
         scale: &[f64],
         steps: AdaptiveSteps,
         interrupted: &dyn Fn() -> bool,
+        mut peek: Option<Peek<'_>>,
     ) -> Result<AdaptiveReport> {
         if !self.tableau.is_adaptive() {
             return Err(invalid!("these device buffers hold a fixed-step method"));
@@ -469,6 +481,9 @@ impl GpuRun {
             }
             if interrupted() {
                 break (c, RunOutcome::Interrupted { steps_done });
+            }
+            if let Some(p) = peek.as_deref_mut() {
+                p(c.t, steps_done, self);
             }
         };
         self.read_state(y)?;
@@ -593,6 +608,11 @@ impl GpuRun {
     fn read_control(&self) -> Result<Control> {
         let bytes = self.map_read(&self.read_control, std::mem::size_of::<Control>())?;
         Ok(bytemuck::pod_read_unaligned(&bytes))
+    }
+
+    /// The state on the device now, read back into `y` (between submissions: a live view's look).
+    pub fn peek_state(&self, y: &mut [f64]) -> Result<()> {
+        self.read_state(y)
     }
 
     fn read_state(&self, y: &mut [f64]) -> Result<()> {

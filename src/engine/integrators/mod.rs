@@ -41,5 +41,5 @@ pub use stroboscopic::{Stroboscopic, MIN_MACRO};
 pub use suspension::Suspension;
 pub use system::{
     require_resolvable, uniform_steps, GroupJacobian, Interrupt, Noise, OdeSystem, Partitioned,
-    Problem, Reach, Stats, StepFailure, Stepper, MIN_RELATIVE_INTERVAL,
+    Problem, Reach, StateWatch, Stats, StepFailure, Stepper, MIN_RELATIVE_INTERVAL,
 };

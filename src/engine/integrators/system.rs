@@ -356,6 +356,11 @@ fn is_zero(n: &u64) -> bool {
 /// Asked at step boundaries whether a run should stop (e.g. after Ctrl-C). It must be cheap.
 pub type Interrupt = std::sync::Arc<dyn Fn() -> bool + Send + Sync>;
 
+/// Shown the time and state inside a long step (stroboscopic averaging's direct periods), as a
+/// live view is shown the scene between steps. It must be cheap: it decides itself whether to
+/// read the state.
+pub type StateWatch = std::sync::Arc<dyn Fn(f64, &[f64]) + Send + Sync>;
+
 /// One time-stepping method.
 pub trait Stepper: Send + Sync {
     /// Advance `y` from `t` towards `t_end` (never past it) and return the new time. On `Err` the
@@ -376,6 +381,16 @@ pub trait Stepper: Send + Sync {
     /// step up, state unchanged, with a failure; the caller, seeing the interrupt set, reports
     /// the interrupt. Steppers of one short step ignore it (their caller asks between steps).
     fn set_interrupt(&mut self, _interrupt: Option<Interrupt>) {}
+
+    /// Whether one step may hold many inner steps of the physical state worth watching one by
+    /// one (stroboscopic averaging's direct periods): such a stepper takes a [`StateWatch`].
+    fn watches_inside(&self) -> bool {
+        false
+    }
+
+    /// Show `watch` the time and state after each inner step of the physical state (`None`: no
+    /// one); steppers whose steps are short ignore it (their caller looks between steps).
+    fn set_watch(&mut self, _watch: Option<StateWatch>) {}
 
     /// An adaptive method's next step from (t, y), its starting step computed if it has none
     /// (which may evaluate the right-hand side); `None` for a method of fixed steps. Another

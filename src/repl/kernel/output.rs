@@ -4,7 +4,7 @@
 use super::shared::Shared;
 use super::wire;
 use crate::repl::session::Session;
-use crate::script::{console, progress, show, Picture};
+use crate::script::{console, progress, show, view_api, Picture};
 use base64::Engine as _;
 use serde_json::{json, Value};
 use std::sync::{Arc, Mutex};
@@ -34,6 +34,21 @@ pub(super) fn route_output(session: &mut Session, shared: &Arc<Shared>) {
     let sh = shared.clone();
     console::set_note_sink(Some(Arc::new(move |s: &str| {
         sh.publish_current("stream", json!({"name": "stderr", "text": s}));
+    })));
+    // A view started in a cell shows its page inline, below the address it prints.
+    let sh = shared.clone();
+    view_api::set_sink(Some(Arc::new(move |url: &str| {
+        let src = url
+            .replace('&', "&amp;")
+            .replace('"', "&quot;")
+            .replace('<', "&lt;");
+        let html = format!(
+            "<iframe src=\"{src}\" width=\"100%\" height=\"480\" style=\"border: 1px solid #ccc\"></iframe>"
+        );
+        sh.publish_current(
+            "display_data",
+            json!({"data": {"text/html": html, "text/plain": url}, "metadata": {}}),
+        );
     })));
     let sh = shared.clone();
     // One display per run: shown at its first line, updated in place, cleared at its end.

@@ -58,7 +58,7 @@ impl Stroboscopic {
     ) -> Result<(), StepFailure> {
         for k in 0..periods {
             let (a, b) = (t + k as f64 * self.period, t + (k + 1) as f64 * self.period);
-            self.direct(sys, a, y, b, stats)?;
+            self.direct(sys, a, y, b, stats, false)?;
             stats.micro_periods += 1;
         }
         Ok(())

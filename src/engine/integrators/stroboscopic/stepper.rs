@@ -3,7 +3,7 @@
 //! [`super`]).
 
 use crate::engine::integrators::system::{
-    Interrupt, OdeSystem, Problem, Stats, StepFailure, Stepper,
+    Interrupt, OdeSystem, Problem, StateWatch, Stats, StepFailure, Stepper,
 };
 
 /// A slope of the averaged flow and the rates of the fast variables on the slow manifold.
@@ -46,6 +46,8 @@ pub struct Stroboscopic {
     direct_periods: u64,
     /// Asked between inner steps: a macro step spans many periods.
     interrupt: Option<Interrupt>,
+    /// Shown the scene's state after each inner step of the direct periods (a live view).
+    watch: Option<StateWatch>,
     /// The latest fall-back to direct integration: its time, why, and the periods integrated
     /// directly since the macro steps last succeeded.
     fallback: Option<Fallback>,
@@ -90,6 +92,7 @@ impl Stroboscopic {
             degree: 2,
             direct_periods: MIN_MACRO,
             interrupt: None,
+            watch: None,
             fallback: None,
             heun_refused: false,
         }
@@ -102,7 +105,8 @@ impl Stroboscopic {
         self
     }
 
-    /// Integrate `y` directly from `t` to `target` with the inner stepper.
+    /// Integrate `y` directly from `t` to `target` with the inner stepper; `watched`: `y` is the
+    /// scene's own state (not a sample's), shown to the watch after every inner step.
     pub(super) fn direct(
         &mut self,
         sys: &mut dyn OdeSystem,
@@ -110,11 +114,16 @@ impl Stroboscopic {
         y: &mut [f64],
         target: f64,
         stats: &mut Stats,
+        watched: bool,
     ) -> Result<f64, StepFailure> {
         self.inner.reset();
+        let watch = self.watch.clone().filter(|_| watched);
         while t < target {
             self.stop_if_interrupted(t)?;
             t = self.inner.step(sys, t, y, target, stats)?;
+            if let Some(w) = &watch {
+                w(t, y);
+            }
         }
         Ok(t)
     }
@@ -190,7 +199,8 @@ impl Stepper for Stroboscopic {
                 (t_end, whole)
             };
             let mut trial = y.to_vec();
-            let t_new = self.direct(sys, t, &mut trial, target, stats)?;
+            // The scene's own periods, run directly: a live view may watch them.
+            let t_new = self.direct(sys, t, &mut trial, target, stats, true)?;
             stats.micro_periods += periods;
             if transient {
                 self.pending_transient -= 1;
@@ -299,6 +309,14 @@ impl Stepper for Stroboscopic {
                 }
             }
         }
+    }
+
+    fn watches_inside(&self) -> bool {
+        true
+    }
+
+    fn set_watch(&mut self, watch: Option<StateWatch>) {
+        self.watch = watch;
     }
 
     fn set_interrupt(&mut self, interrupt: Option<Interrupt>) {
