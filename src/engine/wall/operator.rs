@@ -337,6 +337,32 @@ mod tests {
     use crate::engine::open_space::FAST_KERNEL_SPHERES;
     use nalgebra::DVector;
 
+    /// `n` spheres of radii 0.5 to 1.5 µm above a wall at `z0`, drawn by `next` (uniform in
+    /// [0, 1)): every third below one radius (0.2 a to a: damped, lifted), the rest from 1.05 a
+    /// to `rise` higher, over a square `width` wide.
+    fn spheres_above(
+        next: &mut impl FnMut() -> f64,
+        n: usize,
+        z0: f64,
+        rise: f64,
+        width: f64,
+    ) -> (Vec<f64>, Vec<Vector3<f64>>) {
+        let radii: Vec<f64> = (0..n).map(|_| (0.5 + next()) * 1e-6).collect();
+        let pos = radii
+            .iter()
+            .enumerate()
+            .map(|(k, a)| {
+                let h = if k % 3 == 0 {
+                    (0.2 + 0.8 * next()) * a
+                } else {
+                    a * 1.05 + next() * rise
+                };
+                Vector3::new(next() * width, next() * width, z0 + h)
+            })
+            .collect();
+        (radii, pos)
+    }
+
     /// The product W F against the matrix's (M − D) F, M from the scalar blocks (`wall_correction`
     /// and the self series): RPY and Oseen, unequal radii, a third of the spheres below one
     /// radius (damped, lifted), sizes not a multiple of the lane width on the serial path, the
@@ -359,20 +385,7 @@ mod tests {
         for kind in [Mobility::Rpy, Mobility::Oseen] {
             for n in sizes {
                 let mut op = WallMobility::new(mu, kind, Wall::at(z0).expect("a finite wall"));
-                let radii: Vec<f64> = (0..n).map(|_| (0.5 + next()) * 1e-6).collect();
-                let pos: Vec<Vector3<f64>> = radii
-                    .iter()
-                    .enumerate()
-                    .map(|(k, a)| {
-                        // Every third sphere below one radius (0.2 a to a), the rest above.
-                        let h = if k % 3 == 0 {
-                            (0.2 + 0.8 * next()) * a
-                        } else {
-                            a * 1.05 + next() * 15e-6
-                        };
-                        Vector3::new(next() * 30e-6, next() * 30e-6, z0 + h)
-                    })
-                    .collect();
+                let (radii, pos) = spheres_above(&mut next, n, z0, 15e-6, 30e-6);
                 let forces: Vec<Vector3<f64>> = (0..n)
                     .map(|_| Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 1e-12)
                     .collect();
@@ -457,19 +470,7 @@ mod tests {
         for kind in [Mobility::Rpy, Mobility::Oseen] {
             for n in [6, PARALLEL_IMAGE_SPHERES + 7] {
                 let op = WallMobility::new(mu, kind, Wall::at(z0).expect("a finite wall"));
-                let radii: Vec<f64> = (0..n).map(|_| (0.5 + next()) * 1e-6).collect();
-                let mut pos: Vec<Vector3<f64>> = radii
-                    .iter()
-                    .enumerate()
-                    .map(|(k, a)| {
-                        let h = if k % 3 == 0 {
-                            (0.2 + 0.8 * next()) * a
-                        } else {
-                            a * 1.05 + next() * 8e-6
-                        };
-                        Vector3::new(next() * 12e-6, next() * 12e-6, z0 + h)
-                    })
-                    .collect();
+                let (radii, mut pos) = spheres_above(&mut next, n, z0, 8e-6, 12e-6);
                 // Spheres 1 and 2 (both clear) overlapping.
                 pos[2] = pos[1] + Vector3::new(0.5 * (radii[1] + radii[2]), 0.0, 0.0);
                 pos[2].z = pos[1].z.max(z0 + 1.1 * radii[2]);
