@@ -6,6 +6,7 @@ pub mod kernel;
 pub mod reference;
 mod session;
 pub mod terminal;
+mod view_command;
 
 pub use helper::ReplHelper;
 pub use session::{Reply, Session};

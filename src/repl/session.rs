@@ -2,6 +2,7 @@
 //! defined on earlier inputs stay; the value of an expression is shown; `:commands` are handled
 //! here. The terminal front ends (`super::terminal`) only read lines and print replies.
 
+use super::view_command;
 use crate::script::{self, docs, interrupt, render_error, show};
 use rhai::{Dynamic, Engine, ParseErrorType, Scope, AST};
 
@@ -84,32 +85,6 @@ pub(super) const COMMANDS: &[(&str, &str)] = &[
     (":clear", "forget all variables and functions"),
     (":quit", "leave (Ctrl-D does too)"),
 ];
-
-/// `:view`: the latest live view opened with `xdg-open` where a desktop has one, else its
-/// address to open by hand.
-fn open_view() -> Reply {
-    let Some(url) = script::view_api::live_views().pop() else {
-        return Reply::Error(
-            "no live view is served; start one with s.view() (s being a scene)".into(),
-        );
-    };
-    let desktop = ["DISPLAY", "WAYLAND_DISPLAY"]
-        .iter()
-        .any(|v| std::env::var_os(v).is_some_and(|x| !x.is_empty()));
-    let opened = desktop
-        && std::process::Command::new("xdg-open")
-            .arg(&url)
-            .stdin(std::process::Stdio::null())
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null())
-            .spawn()
-            .is_ok();
-    Reply::Output(if opened {
-        format!("opened {url} in the default browser")
-    } else {
-        format!("{url}\n(no browser opens from here: open that address in one)")
-    })
-}
 
 impl Session {
     /// A fresh session.
@@ -402,7 +377,10 @@ impl Session {
                     )),
                 },
             },
-            "view" => open_view(),
+            "view" => match view_command::open_latest() {
+                Ok(text) => Reply::Output(text),
+                Err(e) => Reply::Error(e),
+            },
             "clear" => {
                 self.scope.clear();
                 self.functions = AST::empty();
