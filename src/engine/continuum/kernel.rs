@@ -29,6 +29,7 @@
 use super::sphere::{gauss_legendre, monomial, monomials, product_rule};
 use crate::engine::averaged::CutoffSwitch;
 use std::collections::BTreeMap;
+use std::sync::Mutex;
 
 /// The averaged model's constants of one swimmer kind (`averaged::pair_constants`): A_R, c_J,
 /// A_N, v0, w0, Λ/ℓ, ℓ.
@@ -196,7 +197,28 @@ pub fn directions() -> (Vec<[f64; 3]>, Vec<f64>) {
 }
 
 /// The folded components of the pair terms of swimmers with constants `c`, those not zero.
+/// They depend on `c` alone and take ~10 ms to fold, so the last few are kept (a script or a
+/// sweep builds many continua of the same swimmers).
 pub fn components(c: &Constants) -> Vec<Component> {
+    const KEPT: usize = 8;
+    type Memo = Vec<([u64; 7], Vec<Component>)>;
+    static MEMO: Mutex<Memo> = Mutex::new(Vec::new());
+    // A poisoned memo only ever holds finished entries.
+    let memo = || MEMO.lock().unwrap_or_else(|e| e.into_inner());
+    let key = [c.a_r, c.c_j, c.a_n, c.v0, c.w0, c.big_l, c.ell].map(f64::to_bits);
+    if let Some((_, v)) = memo().iter().find(|(k, _)| *k == key) {
+        return v.clone();
+    }
+    let v = fold_components(c);
+    let mut m = memo();
+    if m.len() == KEPT {
+        m.remove(0);
+    }
+    m.push((key, v.clone()));
+    v
+}
+
+fn fold_components(c: &Constants) -> Vec<Component> {
     let (dirs, _) = directions();
     let src = monomials(2);
     let mut map: BTreeMap<(usize, i32, [usize; 3], usize), Vec<f64>> = BTreeMap::new();
