@@ -340,8 +340,9 @@ pub struct Stats {
     /// two, or saved and loaded between, draws the same noise (saved only when non-zero).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub noisy_steps: u64,
-    /// Times stroboscopic averaging's macro steps failed at their shortest length and it
-    /// integrated directly instead (saved only when non-zero).
+    /// Times stroboscopic averaging's macro steps failed at their shortest length, or would have
+    /// been too short to pay for their samples, and it integrated directly instead (saved only
+    /// when non-zero).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub direct_fallbacks: u64,
     /// Periods those fallbacks integrated directly (saved only when non-zero).

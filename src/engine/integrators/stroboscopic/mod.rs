@@ -41,8 +41,9 @@
 //!   a fresh run, a changed phase, a loaded scene), a remainder of less than [`MIN_MACRO`] periods
 //!   and the fraction of a period before `t_end` are integrated by the inner (microscopic)
 //!   integrator itself, so a row between period multiples is a true microscopic state; so are
-//!   stretches where macro steps fail at their shortest, counted in [`Stats`] and told, with
-//!   why, by [`Stepper::report`].
+//!   stretches where macro steps fail at their shortest or would be too short to pay for their
+//!   samples (a step spans at least the 6d periods it samples), counted in [`Stats`] and
+//!   told, with why, by [`Stepper::report`].
 //!
 //! Files: `stepper.rs` (the stepper, direct runs and the macro step loop), `samples.rs` (the
 //! stroboscopic points and the slopes read off them, the degree chosen), `macro_step.rs` (one

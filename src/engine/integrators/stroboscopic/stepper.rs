@@ -54,6 +54,9 @@ pub struct Stroboscopic {
     /// Heun's closing step was refused since the start: the motion is not that slow, and it is
     /// not tried again.
     heun_refused: bool,
+    /// `Stats::micro_periods` when the current series of macro step attempts began (the last
+    /// accepted step, direct stretch or start): what rejected attempts have cost since.
+    attempts_from: u64,
 }
 
 /// Macro steps that failed at their shortest length, and the direct integration that followed.
@@ -95,7 +98,15 @@ impl Stroboscopic {
             watch: None,
             fallback: None,
             heun_refused: false,
+            attempts_from: 0,
         }
+    }
+
+    /// The fewest periods a macro step may span at the current degree and still pay for its
+    /// samples: its six new slopes sample `degree` periods each, and a shorter step would cost
+    /// more than integrating its periods directly.
+    fn paying_periods(&self) -> u64 {
+        (6 * self.degree as u64).max(MIN_MACRO)
     }
 
     /// Take macro steps of exactly `m` periods (≥ 1), accepting every step: for measuring the
@@ -144,6 +155,48 @@ impl Stroboscopic {
         Ok(())
     }
 
+    /// The motion is not slow enough for macro steps here: integrate periods directly, at least
+    /// three times as many as the attempts since the last success sampled (so failed attempts
+    /// add at most a third to the direct cost) and twice the last fallback's (from
+    /// [`MIN_MACRO`], up to [`MAX_DIRECT_PERIODS`]), then try macro steps again.
+    #[allow(clippy::too_many_arguments)]
+    fn fall_back(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &mut [f64],
+        whole: u64,
+        why: String,
+        stats: &mut Stats,
+        snap: impl Fn(f64) -> f64,
+    ) -> Result<f64, StepFailure> {
+        self.h_periods = 2.0 * self.paying_periods() as f64;
+        let wasted = stats.micro_periods - self.attempts_from;
+        let k = self.direct_periods.max(3 * wasted).min(whole);
+        self.direct_periods = (2 * self.direct_periods).min(MAX_DIRECT_PERIODS);
+        let mut trial = y.to_vec();
+        self.psi(sys, t, &mut trial, k as u32, stats)?;
+        y.copy_from_slice(&trial);
+        stats.direct_fallbacks += 1;
+        stats.fallback_periods += k;
+        self.attempts_from = stats.micro_periods;
+        match &mut self.fallback {
+            Some(f) => {
+                f.why = why;
+                f.periods += k;
+            }
+            None => {
+                self.fallback = Some(Fallback {
+                    time: t,
+                    why,
+                    periods: k,
+                })
+            }
+        }
+        self.slope = None;
+        Ok(self.leave(snap(t + k as f64 * self.period), y))
+    }
+
     fn leave(&mut self, t: f64, y: &[f64]) -> f64 {
         match &mut self.left {
             Some((lt, ly)) => {
@@ -174,6 +227,7 @@ impl Stepper for Stroboscopic {
             self.degree = 2;
             self.direct_periods = MIN_MACRO;
             self.heun_refused = false;
+            self.attempts_from = stats.micro_periods;
             // First try the whole run in one macro step: a slow motion takes it, and a rejection
             // costs one step's samples.
             self.h_periods = f64::INFINITY;
@@ -207,6 +261,7 @@ impl Stepper for Stroboscopic {
             }
             y.copy_from_slice(&trial);
             self.slope = None;
+            self.attempts_from = stats.micro_periods;
             return Ok(self.leave(t_new, y));
         }
         let k1 = match self.slope.take() {
@@ -219,6 +274,17 @@ impl Stepper for Stroboscopic {
                 Some(m) => m,
                 None => (self.h_periods.min(whole as f64).floor() as u64).clamp(MIN_MACRO, whole),
             };
+            // A step too short to pay for its samples is not tried (Heun's closing step, one
+            // slope, may still be); its periods are integrated directly.
+            let paying = self.paying_periods();
+            let heun_next = m == whole && !self.heun_refused;
+            if self.fixed.is_none() && m < paying && !heun_next {
+                let why = format!(
+                    "they would be shorter than the {paying} periods they sample ({m} asked for, slopes of degree {}), so would not pay",
+                    self.degree
+                );
+                return self.fall_back(sys, t, y, whole, why, stats, snap);
+            }
             // A step that ends the run first tries Heun's method: a slow motion over a short run
             // takes it at the price of one slope, where a rejection costs that slope only, once
             // a run.
@@ -231,6 +297,7 @@ impl Stepper for Stroboscopic {
                         self.direct_periods = MIN_MACRO;
                         stats.macro_steps += 1;
                         self.fallback = None;
+                        self.attempts_from = stats.micro_periods;
                         return Ok(self.leave(snap(t + m as f64 * period), y));
                     }
                     _ => {
@@ -254,6 +321,7 @@ impl Stepper for Stroboscopic {
                     self.direct_periods = MIN_MACRO;
                     stats.macro_steps += 1;
                     self.fallback = None;
+                    self.attempts_from = stats.micro_periods;
                     return Ok(self.leave(t_new, y));
                 }
                 outcome => {
@@ -273,37 +341,13 @@ impl Stepper for Stroboscopic {
                         }
                     };
                     rejects += 1;
-                    if m == MIN_MACRO || rejects > 20 {
-                        // The motion is not slow at this tolerance: periods directly, as many
-                        // as the last fallback's twice (from MIN_MACRO), so the rejected macro
-                        // steps' samples cost at most about as much as the direct periods.
-                        self.h_periods = 2.0 * MIN_MACRO as f64;
-                        let k = self.direct_periods.min(whole);
-                        self.direct_periods = (2 * self.direct_periods).min(MAX_DIRECT_PERIODS);
-                        let mut trial = y.to_vec();
-                        self.psi(sys, t, &mut trial, k as u32, stats)?;
-                        y.copy_from_slice(&trial);
-                        stats.direct_fallbacks += 1;
-                        stats.fallback_periods += k;
-                        let why = if m == MIN_MACRO {
+                    if m <= paying || rejects > 20 {
+                        let why = if m <= paying {
                             format!("{why}, the shortest a macro step may be")
                         } else {
                             format!("{rejects} macro steps in a row were rejected; the last: {why}")
                         };
-                        match &mut self.fallback {
-                            Some(f) => {
-                                f.why = why;
-                                f.periods += k;
-                            }
-                            None => {
-                                self.fallback = Some(Fallback {
-                                    time: t,
-                                    why,
-                                    periods: k,
-                                })
-                            }
-                        }
-                        return Ok(self.leave(snap(t + k as f64 * period), y));
+                        return self.fall_back(sys, t, y, whole, why, stats, snap);
                     }
                     self.h_periods = m as f64 * shrink;
                 }
