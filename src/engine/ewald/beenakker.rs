@@ -14,7 +14,7 @@ use crate::engine::parallel::PARALLEL_IMAGE_SPHERES;
 use crate::engine::periodic::PeriodicBox;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_2_SQRT_PI, PI};
 
 /// The periodic mobility of spheres in one box, with its splitting and truncation fixed.
 #[derive(Debug, Clone)]
@@ -73,8 +73,8 @@ impl Ewald {
                 // Measured costs per term, in units of one wave per sphere (its phase, the
                 // structure factors and the velocity, in vector lanes): with r_c ≤ L/2 a
                 // candidate of the cell lists (every sphere in the cells around one, in lanes)
-                // ~3; else an image within r_c (libm's erfc and exp) ~10 and a lattice shift
-                // tested per pair ~0.4.
+                // ~3; else an image within r_c (erfc and exp from the table) ~10 and a lattice
+                // shift tested per pair ~0.4.
                 let cost = |xi: f64| {
                     let (im, wv) = counts(xi);
                     let rc = p / xi;
@@ -88,7 +88,10 @@ impl Ewald {
                             .product();
                         n * n * 3.0 * frac
                     } else {
-                        n * n * (10.0 * im + 0.4 * 27.0f64.max(8.0 * im))
+                        // Below PARALLEL_IMAGE_SPHERES each pair is evaluated once for both
+                        // spheres, at half the cost.
+                        let per_pair = if spheres < PARALLEL_IMAGE_SPHERES { 0.5 } else { 1.0 };
+                        n * n * per_pair * (10.0 * im + 0.4 * 27.0f64.max(8.0 * im))
                     };
                     real + n * wv
                 };
@@ -245,7 +248,11 @@ impl Ewald {
             if r2 == 0.0 || r2 > self.rc2 {
                 continue;
             }
-            let (ci, crr) = self.split.real(r2.sqrt(), s);
+            let d = r2.sqrt();
+            let (erfc, gauss) = self.erfc.eval(self.split.xi * d);
+            let (ci, crr) =
+                self.split
+                    .real_with(d, 1.0 / d, s, erfc, gauss * (0.5 * FRAC_2_SQRT_PI));
             visit(&r, r2, ci, crr);
         }
     }
@@ -299,6 +306,30 @@ impl Ewald {
                 out,
                 parallel,
             );
+        } else if !parallel {
+            // Each pair once: its images' terms depend on r only through r r^T and |r|, the same
+            // for r and −r, so one evaluation serves both spheres.
+            for i in 0..n {
+                let mut v = self.split.self_excess(radii[i]) * forces[i]
+                    + self.real_apply(
+                        &Vector3::zeros(),
+                        self.split.s(radii[i], radii[i]),
+                        &forces[i],
+                    );
+                for j in i + 1..n {
+                    let r0 = self.periodic.min_image(pos[i] - pos[j]);
+                    let (fi, fj) = (forces[i], forces[j]);
+                    let mut w = Vector3::zeros();
+                    self.real_images(&r0, self.split.s(radii[i], radii[j]), |r, r2, ci, crr| {
+                        v += ci * fj + r * (crr * r.dot(&fj) / r2);
+                        w += ci * fi + r * (crr * r.dot(&fi) / r2);
+                    });
+                    v += self.split.overlap_apply(&r0, radii[i], radii[j], &fj) / unit;
+                    w += self.split.overlap_apply(&-r0, radii[j], radii[i], &fi) / unit;
+                    out[j] += w;
+                }
+                out[i] += v;
+            }
         } else {
             let row = |i: usize, u: &mut Vector3<f64>| {
                 let mut v = self.split.self_excess(radii[i]) * forces[i];
