@@ -92,13 +92,14 @@ fn transcript_of_a_session() {
 #[test]
 fn long_runs_show_a_progress_bar() {
     let mut s = start();
-    // The direct step: the default auto(tol) would average 3,000 periods in a blink.
+    // The direct step: the default auto(tol) would average 1,000 periods in a blink. Directly
+    // they take ~2 s here, well past the bar's 0.5 s delay.
     step(
         &mut s,
         "let s = scene(); s.add(dumbbell()); s.integrator = rk4(s.direct_step);",
         "",
     );
-    s.send_line("s.run_periods(3000); s.count").unwrap();
+    s.send_line("s.run_periods(1000); s.count").unwrap();
     s.expect("periods/s").expect("a progress bar");
     s.expect("=> 1").unwrap();
     s.expect(PROMPT).unwrap();
