@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 use swimlab::engine::averaged::{AveragedSystem, Shortcuts};
 use swimlab::engine::continuum::kernel::{self, Constants, Radial};
 use swimlab::engine::continuum::sphere::{monomial, monomials, product_rule};
-use swimlab::engine::continuum::{BaseState, Continuum, ContinuumSpec};
+use swimlab::engine::continuum::{BaseState, Closure, Continuum, ContinuumSpec};
 use swimlab::engine::fields::FieldKind;
 use swimlab::engine::integrators::OdeSystem;
 use swimlab::engine::{Coefficients, Dumbbell, Model, Scene};
@@ -662,6 +662,61 @@ fn thermal_modes_decay_at_the_dumbbells_diffusion_rates() {
     let a1 = c.mode(FieldKind::Density, None, [1, 0, 0]).unwrap()[0];
     let want = (modes[0].rate * t).exp();
     assert!(((a1 / a0).re - want).abs() <= 1e-6, "{} vs {want}", a1 / a0);
+}
+
+/// A closure's effective diffusion is diffusion: at temperature 0, one population (no mean field)
+/// relaxes at exactly its rates, the density at −D_t k², the polarization at −2D_r − D_t k², the
+/// nematic order at −6D_r − D_t k² (isotropic D_t couples no harmonics: exact to the eigen-solver's
+/// rounding, 1e-9 here); with noise as well, the closure adds to the dumbbell's own rates.
+/// Nonsense is refused with what a closure takes.
+#[test]
+fn a_closure_adds_its_diffusion() {
+    let d = asymmetric();
+    let side = 40.0 * d.ell;
+    let mut s = Scene::new();
+    s.set_model(Model::Averaged);
+    s.set_box(Some([side; 3])).unwrap();
+    s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
+    let (dr, dt) = (0.03, 2e-13);
+    let spec = |closure: Option<Closure>| ContinuumSpec {
+        grid: [8, 8, 8],
+        closure,
+        ..Default::default()
+    };
+    let closure = Closure::new(dr, dt, "a test's numbers").unwrap();
+    let k = [2.0 * PI / side, 0.0, 0.0];
+    let k2 = k[0] * k[0];
+    let rates = |c: &Continuum| {
+        let modes = c.growth_rates(&BaseState::Isotropic, k).unwrap();
+        [0, 1, 2].map(|l| modes.iter().find(|m| m.degree == l).unwrap().rate)
+    };
+    let c = Continuum::of(&s, &spec(Some(closure.clone()))).unwrap();
+    assert_eq!(c.closure(), Some(&closure));
+    let got = rates(&c);
+    let want = [-dt * k2, -2.0 * dr - dt * k2, -6.0 * dr - dt * k2];
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).abs() <= 1e-9 * w.abs(), "{got:?} vs {want:?}");
+    }
+    // Without a closure and without noise nothing relaxes.
+    let none = Continuum::of(&s, &spec(None))
+        .unwrap()
+        .growth_rates(&BaseState::Isotropic, k)
+        .unwrap();
+    assert!(none.iter().all(|m| m.rate.abs() <= 1e-12 * dr), "{none:?}");
+    // With noise the rates add: the dumbbell's own plus the closure's.
+    s.set_temperature(300.0).unwrap();
+    let thermal = rates(&Continuum::of(&s, &spec(None)).unwrap());
+    let both = rates(&Continuum::of(&s, &spec(Some(closure))).unwrap());
+    for l in 0..3 {
+        let add = want[l];
+        assert!(
+            (both[l] - thermal[l] - add).abs() <= 1e-6 * add.abs(),
+            "degree {l}: {both:?} = {thermal:?} + {want:?}?"
+        );
+    }
+    assert!(Closure::new(-1.0, 0.0, "x").is_err());
+    assert!(Closure::new(0.1, f64::NAN, "x").is_err());
+    assert!(Closure::new(0.1, 0.0, " ").is_err());
 }
 
 /// A continuum's runs take a scene's run control: the progress is told the time after every

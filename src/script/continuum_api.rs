@@ -7,7 +7,7 @@ use super::convert::{array3, describe, lift, number, script_error, vector3, Scri
 use super::doc::{doc_entry, Doc};
 use super::scene_api::{SceneHandle, SweepCount};
 use crate::engine::continuum::{
-    particle_mode, BaseState, Continuum, ContinuumSpec, Mode, WholeOption,
+    particle_mode, BaseState, Closure, Continuum, ContinuumSpec, Mode, WholeOption,
 };
 use crate::engine::fields::{Field, FieldKind};
 use rhai::{Array, Dynamic, Engine, Map, INT};
@@ -64,9 +64,15 @@ impl std::fmt::Display for ContinuumHandle {
             .iter()
             .map(|p| format!("{:.4} rad ({} swimmers)", p.phase, p.swimmers))
             .collect();
+        let closure = c.closure().map_or(String::new(), |k| {
+            format!(
+                ", closure D_r {:.4e} 1/s and D_t {:.4e} m²/s (fitted: {})",
+                k.rotation, k.translation, k.fitted
+            )
+        });
         write!(
             f,
-            "Continuum(grid {:?}, orientations to degree {}, populations at {}, core {:.3e} m, cutoff {:.3e} m, t = {:.6e} s)",
+            "Continuum(grid {:?}, orientations to degree {}, populations at {}, core {:.3e} m, cutoff {:.3e} m{closure}, t = {:.6e} s)",
             c.grid(),
             c.degree(),
             phases.join(", "),
@@ -77,7 +83,7 @@ impl std::fmt::Display for ContinuumHandle {
     }
 }
 
-const FIX: &str = "use #{ grid: 16 or [nx, ny, nz], orientations: 4, core: metres, width: metres, phases: bins, tol: 1e-6 }";
+const FIX: &str = "use #{ grid: 16 or [nx, ny, nz], orientations: 4, core: metres, width: metres, phases: bins, tol: 1e-6, closure: #{ rotation, translation, fitted } }";
 
 /// A whole-number option of `continuum(s, opts)`: anything but a whole number of 0 or more is
 /// refused with what the option accepts (the engine's words, as its own refusals say).
@@ -120,6 +126,7 @@ fn spec(opts: &Map) -> ScriptResult<ContinuumSpec> {
             "width" => s.width = Some(number("continuum width", v)?),
             "phases" => s.phase_bins = Some(whole("continuum phases", WholeOption::PhaseBins, v)?),
             "tol" => s.tol = number("continuum tol", v)?,
+            "closure" => s.closure = Some(closure(v)?),
             other => {
                 return Err(script_error(format!(
                     "continuum: unknown option \"{other}\"; {FIX}"
@@ -128,6 +135,47 @@ fn spec(opts: &Map) -> ScriptResult<ContinuumSpec> {
         }
     }
     Ok(s)
+}
+
+const CLOSURE_FIX: &str =
+    "use closure: #{ rotation: 1/s, translation: m²/s, fitted: \"where it was measured\" }";
+
+/// `closure: #{ rotation, translation, fitted }`: an effective diffusion measured from particle
+/// runs, and where.
+fn closure(v: &Dynamic) -> ScriptResult<Closure> {
+    let Some(m) = v.clone().try_cast::<Map>() else {
+        return Err(script_error(format!(
+            "continuum closure must be a map, got {}; {CLOSURE_FIX}",
+            describe(v)
+        )));
+    };
+    if let Some(k) = m
+        .keys()
+        .find(|k| !["rotation", "translation", "fitted"].contains(&k.as_str()))
+    {
+        return Err(script_error(format!(
+            "continuum closure: unknown key \"{k}\" (known: rotation, translation, fitted); {CLOSURE_FIX}"
+        )));
+    }
+    let coefficient = |key: &str| match m.get(key) {
+        Some(x) => number(&format!("closure {key}"), x),
+        None => Ok(0.0),
+    };
+    let fitted = match m.get("fitted") {
+        Some(f) if f.is_string() => f.clone().into_string().unwrap_or_default(),
+        Some(f) => {
+            return Err(script_error(format!(
+                "closure fitted must be a string saying where the closure was measured, got {}; {CLOSURE_FIX}",
+                describe(f)
+            )))
+        }
+        None => String::new(),
+    };
+    lift(Closure::new(
+        coefficient("rotation")?,
+        coefficient("translation")?,
+        &fitted,
+    ))
 }
 
 fn build(s: &SceneHandle, opts: &Map) -> ScriptResult<ContinuumHandle> {
@@ -469,7 +517,7 @@ const TWO: &str = "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
 pub(super) const DOCS: &[Doc] = &[
-    doc_entry!("continuum", "continuum", "continuum(s) -> Continuum\ncontinuum(s, #{ grid, orientations, core, width, phases, tol })\nc.copy() -> Continuum", "The kinetic theory of the averaged model for scene s's swimmers: one distribution f_p(x, n) per phase population in s's periodic box, moved by the mean field that the averaged pair terms (I, J, K, L, s.coefficients) give when summed over the distribution, and by the rigid dumbbells' diffusion when s.temperature > 0. It starts from the swimmers smoothed by a Gaussian of the given width (m; default one cell; from a quarter of the largest cell side to half the box's longest side), as s.field smooths them. Pairs closer than core (m; default one length l; from l/4 up to the cutoff: the pair terms are the leading terms of an expansion in l/D for swimmers far apart, and closer than l/4 they describe no pair the particles have) or beyond s's cutoff (as in the particle runs) are left out. grid: cells per axis (a number or [nx, ny, nz], 4 or more per axis, at most 32768 cells, default 16); orientations: harmonic degree L of the orientation basis (2-8, default 4); phases: bin the phases into this many populations (1-16; default: one per distinct phase, at most 16); tol: the time stepping's tolerance relative to the structure (1e-10 <= tol < 1, default 1e-6). One swimmer kind (equal radii, length, amplitude, omega). Every pair term carries sin(phi_p - phi_q): one population, or phases spread evenly, has no mean-field motion. A continuum runs (c.run_periods(n), c.run(seconds)) up to 1e9 stroke periods, as a scene. c.copy() is an independent copy (same state); `let d = c;` would name the same continuum.", TWO),
+    doc_entry!("continuum", "continuum", "continuum(s) -> Continuum\ncontinuum(s, #{ grid, orientations, core, width, phases, tol, closure })\nc.copy() -> Continuum", "The kinetic theory of the averaged model for scene s's swimmers: one distribution f_p(x, n) per phase population in s's periodic box, moved by the mean field that the averaged pair terms (I, J, K, L, s.coefficients) give when summed over the distribution, and by the rigid dumbbells' diffusion when s.temperature > 0. It starts from the swimmers smoothed by a Gaussian of the given width (m; default one cell; from a quarter of the largest cell side to half the box's longest side), as s.field smooths them. Pairs closer than core (m; default one length l; from l/4 up to the cutoff: the pair terms are the leading terms of an expansion in l/D for swimmers far apart, and closer than l/4 they describe no pair the particles have) or beyond s's cutoff (as in the particle runs) are left out. grid: cells per axis (a number or [nx, ny, nz], 4 or more per axis, at most 32768 cells, default 16); orientations: harmonic degree L of the orientation basis (2-8, default 4); phases: bin the phases into this many populations (1-16; default: one per distinct phase, at most 16); tol: the time stepping's tolerance relative to the structure (1e-10 <= tol < 1, default 1e-6); closure: #{ rotation (1/s), translation (m²/s), fitted } adds an effective rotational and isotropic translational diffusion to the thermal one (or gives one at temperature 0): the fluctuations and correlations of a suspension the mean field leaves out, measured from particle runs (e.g. rotational_diffusion and translational_diffusion of an averaged-model suspension), with fitted saying where (required; shown by display(c)). One swimmer kind (equal radii, length, amplitude, omega). Every pair term carries sin(phi_p - phi_q): one population, or phases spread evenly, has no mean-field motion. A continuum runs (c.run_periods(n), c.run(seconds)) up to 1e9 stroke periods, as a scene. c.copy() is an independent copy (same state); `let d = c;` would name the same continuum.", TWO),
     doc_entry!("counts", "continuum", "c.counts() -> array", "The number of swimmers in each population (the integral of its density): conserved by the dynamics to round-off.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(c.counts());"),
     doc_entry!("populations", "continuum", "c.populations -> array", "The phase populations: #{ phase (rad), swimmers (how many the scene had) } each, in the order fields and modes number them.", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(c.populations);"),
     doc_entry!("mode", "continuum", "c.mode(kind, [nx, ny, nz]) -> map\nc.mode(kind, [nx, ny, nz], population) -> map\ns.mode(kind, [nx, ny, nz]) -> map\ns.mode(kind, [nx, ny, nz], #{ phase }) -> map", "The Fourier amplitude at box wave vector k = 2 pi n / L of the swimmers' density (kind \"density\": sum_j exp(-i k.R_j)), polarization (sum_j N_j exp(-i k.R_j)) or nematic tensor (sum_j (3 N_j N_j - I)/2 exp(-i k.R_j), row by row): the integral of rho, rho Pi or rho Q times exp(-i k.x) for a continuum, the sum over the swimmers (of one phase, if given: one the swimmers have) for a scene, so the two compare directly. #{ re: [...], im: [...], abs }. A continuum holds the modes its grid keeps against aliasing, |n| < cells/3 per axis (|n| <= 1 on 4 cells, 2 on 8, 5 on 16); a scene's modes go to 1e9 per axis (beyond, f64 rounds the phase 2 pi n.x/L by more than 1e-6 rad).", "let s = scene(); s.model = \"averaged\"; s.box = [60e-6, 60e-6, 60e-6]; s.add_random(dumbbell(), 20, 1, #{ phase: 0.0 }); s.add_random(dumbbell(), 20, 2, #{ phase: pi() / 2.0 }); let c = continuum(s, #{ grid: 8, orientations: 2 }); print(s.mode(\"density\", [1, 0, 0]).abs); print(c.mode(\"density\", [1, 0, 0]).abs);"),

@@ -57,7 +57,7 @@ impl Continuum {
             ell: c[6],
         };
         let thermal = scene.thermal();
-        let diffusion = if thermal.is_on() {
+        let mut diffusion = if thermal.is_on() {
             Some(RigidDiffusion::new(
                 &first,
                 first.ell,
@@ -68,6 +68,21 @@ impl Continuum {
         } else {
             None
         };
+        // A closure adds its isotropic diffusion to the thermal one (or stands alone).
+        if let Some(c) = &spec.closure {
+            let base = diffusion.unwrap_or(RigidDiffusion {
+                parallel: 0.0,
+                perpendicular: 0.0,
+                rotation: 0.0,
+                offset: 0.0,
+            });
+            diffusion = Some(RigidDiffusion {
+                parallel: base.parallel + c.translation,
+                perpendicular: base.perpendicular + c.translation,
+                rotation: base.rotation + c.rotation,
+                offset: base.offset,
+            });
+        }
         let phases: Vec<f64> = pops.iter().map(|p| p.phase).collect();
         let op = Operator::new(
             spec.grid,
@@ -108,6 +123,7 @@ impl Continuum {
             period: first.period(),
             tol: spec.tol,
             kind: first,
+            closure: spec.closure.clone(),
             control: RunControl::default(),
         };
         c.filter_state();

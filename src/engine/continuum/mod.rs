@@ -36,8 +36,8 @@ mod state;
 
 pub use reading::{fourier_mode, particle_mode, MAX_PARTICLE_MODE};
 pub use spec::{
-    ContinuumSpec, Population, WholeOption, MAX_CELLS, MAX_POPULATIONS, MIN_CELLS_PER_AXIS,
-    MIN_CORE_IN_LENGTHS, MIN_DEGREE, MIN_TOL,
+    Closure, ContinuumSpec, Population, WholeOption, MAX_CELLS, MAX_POPULATIONS,
+    MIN_CELLS_PER_AXIS, MIN_CORE_IN_LENGTHS, MIN_DEGREE, MIN_TOL,
 };
 pub use stability::{BaseState, Mode};
 pub use state::Continuum;

@@ -42,6 +42,49 @@ pub struct ContinuumSpec {
     pub phase_bins: Option<usize>,
     /// Relative tolerance of the time stepping, against the structure.
     pub tol: f64,
+    /// An effective diffusion added to the thermal one: the fluctuations and correlations of a
+    /// suspension that the mean field leaves out, measured from particle runs.
+    pub closure: Option<Closure>,
+}
+
+/// A closure of the mean field: an effective rotational and translational diffusion of each
+/// swimmer, measured from particle runs, and where it was measured (fitted on one set of runs,
+/// it is held against others).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Closure {
+    /// D_r (1/s).
+    pub rotation: f64,
+    /// D_t, isotropic (m²/s).
+    pub translation: f64,
+    /// Where it was fitted, in words ("averaged model, phi = 1%, 8 seeds of 64 swimmers").
+    pub fitted: String,
+}
+
+impl Closure {
+    /// A closure of rotational diffusion `rotation` (1/s) and translational `translation`
+    /// (m²/s), fitted where `fitted` says.
+    pub fn new(rotation: f64, translation: f64, fitted: &str) -> Result<Closure> {
+        for (name, v, unit) in [
+            ("rotation", rotation, "1/s"),
+            ("translation", translation, "m²/s"),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(invalid!(
+                    "the closure's {name} must be a diffusion coefficient of zero or more ({unit}), got {v}"
+                ));
+            }
+        }
+        if fitted.trim().is_empty() {
+            return Err(invalid!(
+                "a closure says where it was fitted: give fitted: \"...\" (the model, density and runs it was measured on)"
+            ));
+        }
+        Ok(Closure {
+            rotation,
+            translation,
+            fitted: fitted.to_string(),
+        })
+    }
 }
 
 impl Default for ContinuumSpec {
@@ -53,6 +96,7 @@ impl Default for ContinuumSpec {
             width: None,
             phase_bins: None,
             tol: 1e-6,
+            closure: None,
         }
     }
 }

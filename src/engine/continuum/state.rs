@@ -2,7 +2,7 @@
 //! its plain reading (sizes, counts, means).
 
 use super::operator::Kinetic;
-use super::spec::Population;
+use super::spec::{Closure, Population};
 use crate::engine::error::{invalid, Result};
 use crate::engine::integrators::{Dopri5, Stats};
 use crate::engine::stepping::RunControl;
@@ -28,6 +28,8 @@ pub struct Continuum {
     pub(super) tol: f64,
     /// The swimmer kind (phase aside).
     pub(super) kind: Dumbbell,
+    /// The effective diffusion it was given, if any.
+    pub(super) closure: Option<Closure>,
     /// What every run takes: the interrupt and the progress report (a scene's run control).
     pub(super) control: RunControl,
 }
@@ -83,6 +85,10 @@ impl Continuum {
     /// The time stepping's relative tolerance.
     pub fn tol(&self) -> f64 {
         self.tol
+    }
+    /// The effective diffusion it was given (a closure of the mean field), if any.
+    pub fn closure(&self) -> Option<&Closure> {
+        self.closure.as_ref()
     }
     /// The smoothing width the particles were deposited with (m).
     pub fn width(&self) -> f64 {
