@@ -600,6 +600,17 @@ fn particles_sampled_from_the_distribution_feel_the_mean_field_on_average() {
     }
 }
 
+/// One asymmetric swimmer of the averaged model in a box of 40ℓ: one population, no mean field.
+fn one_swimmer_in_a_box() -> (Scene, f64) {
+    let d = asymmetric();
+    let side = 40.0 * d.ell;
+    let mut s = Scene::new();
+    s.set_model(Model::Averaged);
+    s.set_box(Some([side; 3])).unwrap();
+    s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
+    (s, side)
+}
+
 /// With thermal noise, one population (no mean field) in the isotropic state relaxes by diffusion
 /// alone: the slowest mode at small k is the density's, −D_t k² with D_t = (D∥ + 2D⊥)/3 of the
 /// rigid dumbbell, up to the anisotropy's coupling to the nematic mode, a relative
@@ -608,12 +619,7 @@ fn particles_sampled_from_the_distribution_feel_the_mean_field_on_average() {
 /// wave's amplitude after one relaxation time is e^{σt} of its start to 1e-6.
 #[test]
 fn thermal_modes_decay_at_the_dumbbells_diffusion_rates() {
-    let d = asymmetric();
-    let side = 40.0 * d.ell;
-    let mut s = Scene::new();
-    s.set_model(Model::Averaged);
-    s.set_box(Some([side; 3])).unwrap();
-    s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
+    let (mut s, side) = one_swimmer_in_a_box();
     s.set_temperature(300.0).unwrap();
     let diff = s.rigid_diffusion(0).unwrap();
     let spec = ContinuumSpec {
@@ -671,12 +677,7 @@ fn thermal_modes_decay_at_the_dumbbells_diffusion_rates() {
 /// Nonsense is refused with what a closure takes.
 #[test]
 fn a_closure_adds_its_diffusion() {
-    let d = asymmetric();
-    let side = 40.0 * d.ell;
-    let mut s = Scene::new();
-    s.set_model(Model::Averaged);
-    s.set_box(Some([side; 3])).unwrap();
-    s.add(d, Vector3::zeros(), Vector3::x()).unwrap();
+    let (mut s, side) = one_swimmer_in_a_box();
     let (dr, dt) = (0.03, 2e-13);
     let spec = |closure: Option<Closure>| ContinuumSpec {
         grid: [8, 8, 8],
