@@ -160,8 +160,8 @@ enum BenchKind {
     /// methods' difference against the tolerance and the crossover "auto" uses.
     Ewald,
     /// One right-hand side of a suspension at volume fraction 1% in a periodic box and above a
-    /// wall against the same swimmers in open space, microscopic and rigid-stroke models, 64, 100,
-    /// 256 and 1,000 swimmers (--quick: 100), side by side.
+    /// wall against the same swimmers in open space, microscopic and rigid-stroke models, 16, 64,
+    /// 100, 256 and 1,000 swimmers (--quick: 100), side by side.
     Boundaries {
         /// The box's Ewald tolerance (default: the scene's, a tenth of the default integrator's
         /// drift tolerance).
