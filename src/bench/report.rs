@@ -142,7 +142,11 @@ fn run_kind(
             say("\nCSV written to out/bench/ewald.csv")?;
         }
         Kind::Boundaries { ewald_tol } => {
-            let sizes: &[usize] = if quick { &[100] } else { &[16, 64, 100, 256, 1000] };
+            let sizes: &[usize] = if quick {
+                &[100]
+            } else {
+                &[16, 64, 100, 256, 1000]
+            };
             let rows = boundaries::run(sizes, ewald_tol)?;
             let t = boundaries::table(&rows);
             say(&format!(
