@@ -486,3 +486,35 @@ fn the_radial_quadrature_is_graded_to_the_core() {
         }
     }
 }
+
+/// A closure is refused unless it is a map of diffusion coefficients and says where it was
+/// fitted; a good one is shown with the continuum.
+#[test]
+fn a_closure_is_checked_and_shown() {
+    let tries = [
+        "continuum(b, #{ closure: 3 })",
+        "continuum(b, #{ closure: #{ rotation: -1, fitted: \"x\" } })",
+        "continuum(b, #{ closure: #{ rotation: 0.1 } })",
+        "continuum(b, #{ closure: #{ rot: 0.1, fitted: \"x\" } })",
+        "continuum(b, #{ closure: #{ translation: \"big\", fitted: \"x\" } })",
+        "continuum(b, #{ closure: #{ rotation: 0.1, fitted: 2 } })",
+    ]
+    .map(|t| format!("try {{ {t}; print(\"accepted\"); }} catch (e) {{ print(e); }}\n"))
+    .concat();
+    let out = case(
+        &format!(
+            "{C}{tries}print(continuum(b, #{{ grid: 4, orientations: 2, closure: #{{ rotation: 0.02, translation: 1e-13, fitted: \"here\" }} }}));\n"
+        ),
+        &[
+            "continuum closure must be a map, got 3",
+            "the closure's rotation must be a diffusion coefficient of zero or more (1/s), got -1",
+            "a closure says where it was fitted",
+            "continuum closure: unknown key \"rot\"",
+            "continuum closure translation must be a number",
+            "continuum closure fitted must be a string",
+            "closure D_r 2.0000e-2 1/s and D_t 1.0000e-13 m²/s (fitted: here)",
+        ],
+        0,
+    );
+    assert!(!out.contains("accepted"), "{out}");
+}

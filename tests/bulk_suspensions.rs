@@ -163,7 +163,7 @@ fn run(mut s: Scene, spec: IntegratorSpec, periods: f64) -> Simulation {
 // bounded by its difference from RK4 at T/128: the pair in contact makes RK4 converge late, but
 // its error falls at least twofold per halving from T/128 on (measured: 3.2e-7 from T/64 to
 // T/128, 6.3e-9 from T/128 to T/256), so the T/256 reference is within that difference, below
-// 1e-8, a tenth of the smallest error compared below (8e-7 at tol 1e-4). At the default
+// 1e-8, well under a tenth of the smallest error compared below (8e-7 at tol 1e-4). At the default
 // tolerance the stepper is within 1e-3 of the RMS displacement (the bar), and the error
 // falls with tol.
 #[test]

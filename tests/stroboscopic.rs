@@ -124,7 +124,7 @@ fn a_closing_step_takes_heun_where_the_motion_is_slow_enough() {
             assert_eq!((stats.micro_periods, stats.rejected), (5, 0), "eps {eps}");
         } else {
             assert!(
-                stats.micro_periods > 5 && stats.rejected >= 1,
+                stats.micro_periods > 5 && stats.rejected >= 1 && stats.macro_steps == 1,
                 "eps {eps}: {stats:?}"
             );
         }
@@ -361,7 +361,8 @@ fn close_pairs_keep_the_tolerance() {
 /// a pair 1.6ℓ apart at tol 1e-8, whose macro steps all fail, over 200 periods. Each direct
 /// stretch is at least three times the sample periods the failed attempts before it cost, so
 /// those add at most a third, plus the last series of attempts (one probe and one step, ~40
-/// periods); 1.5 × the run's periods bounds both. Measured 1.40×; before the rule, 2.41×.
+/// periods): (4/3)·200 + 40 ≈ 307 sample periods, below the 1.6 × 200 = 320 required. Measured
+/// 1.40×; before the rule, 2.41×.
 #[test]
 fn where_macro_steps_cannot_pay_the_run_is_about_as_costly_as_the_direct_one() {
     let mut s = Scene::new();
@@ -386,7 +387,7 @@ fn where_macro_steps_cannot_pay_the_run_is_about_as_costly_as_the_direct_one() {
     let st = sim.stats();
     eprintln!("{st:?}");
     assert!(st.direct_fallbacks >= 1, "{st:?}");
-    assert!(st.micro_periods as f64 <= 1.5 * 200.0, "{st:?}");
+    assert!(st.micro_periods as f64 <= 1.6 * 200.0, "{st:?}");
 }
 
 #[test]

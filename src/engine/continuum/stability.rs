@@ -143,9 +143,11 @@ pub(super) fn linear_operator(
     base: &BaseState,
     k: [f64; 3],
 ) -> Result<DMatrix<Complex64>> {
-    if matches!(base, BaseState::Polar(_)) && op.diffusion.is_some() {
+    if matches!(base, BaseState::Polar(_))
+        && op.diffusion.as_ref().is_some_and(|d| d.rotation > 0.0)
+    {
         return Err(invalid!(
-            "with thermal noise the polar state is not stationary (its polarization decays at 2 D_r), so it has no growth rates; linearise about the isotropic state, or build the continuum from a scene at temperature 0"
+            "with rotational diffusion (thermal noise, or a closure's rotation) the polar state is not stationary (its polarization decays at 2 D_r), so it has no growth rates; linearise about the isotropic state, or build the continuum at temperature 0 without a closure's rotation"
         ));
     }
     if k.iter().any(|x| !x.is_finite()) {

@@ -345,11 +345,8 @@ impl Ewald {
                 }
                 *u += v;
             };
-            if parallel {
-                out.par_iter_mut().enumerate().for_each(|(i, u)| row(i, u));
-            } else {
-                out.iter_mut().enumerate().for_each(|(i, u)| row(i, u));
-            }
+            // Many spheres: a row per sphere, the rows in parallel.
+            out.par_iter_mut().enumerate().for_each(|(i, u)| row(i, u));
         }
         out.iter_mut().for_each(|u| *u *= unit);
     }

@@ -171,7 +171,7 @@ impl Stroboscopic {
         snap: impl Fn(f64) -> f64,
     ) -> Result<f64, StepFailure> {
         self.h_periods = 2.0 * self.paying_periods() as f64;
-        let wasted = stats.micro_periods - self.attempts_from;
+        let wasted = stats.micro_periods.saturating_sub(self.attempts_from);
         let k = self.direct_periods.max(3 * wasted).min(whole);
         self.direct_periods = (2 * self.direct_periods).min(MAX_DIRECT_PERIODS);
         let mut trial = y.to_vec();
@@ -277,12 +277,15 @@ impl Stepper for Stroboscopic {
             // A step too short to pay for its samples is not tried (Heun's closing step, one
             // slope, may still be); its periods are integrated directly.
             let paying = self.paying_periods();
+            let too_short = |st: &Self| {
+                format!(
+                    "they would be shorter than the {paying} periods they sample ({m} asked for, slopes of degree {}), so would not pay",
+                    st.degree
+                )
+            };
             let heun_next = m == whole && !self.heun_refused;
             if self.fixed.is_none() && m < paying && !heun_next {
-                let why = format!(
-                    "they would be shorter than the {paying} periods they sample ({m} asked for, slopes of degree {}), so would not pay",
-                    self.degree
-                );
+                let why = too_short(self);
                 return self.fall_back(sys, t, y, whole, why, stats, snap);
             }
             // A step that ends the run first tries Heun's method: a slow motion over a short run
@@ -303,6 +306,10 @@ impl Stepper for Stroboscopic {
                     _ => {
                         stats.rejected += 1;
                         self.heun_refused = true;
+                        if m < paying {
+                            let why = too_short(self);
+                            return self.fall_back(sys, t, y, whole, why, stats, snap);
+                        }
                     }
                 }
             }
@@ -343,7 +350,7 @@ impl Stepper for Stroboscopic {
                     rejects += 1;
                     if m <= paying || rejects > 20 {
                         let why = if m <= paying {
-                            format!("{why}, the shortest a macro step may be")
+                            format!("{why}, and a shorter step would not pay for its samples")
                         } else {
                             format!("{rejects} macro steps in a row were rejected; the last: {why}")
                         };
