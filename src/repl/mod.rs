@@ -1,6 +1,7 @@
 //! The interactive shell over [`crate::script`]: session logic ([`Session`]) apart from the
 //! terminal ([`terminal`]), so the logic is tested without one.
 
+mod completion;
 mod helper;
 pub mod kernel;
 pub mod reference;
