@@ -4,7 +4,7 @@
 //! each kernel is a pair of files, `name.rs` (host side: pipelines, data layout) and `name.wgsl`
 //! (the shader), all sharing `common.rs` and `common.wgsl`; [`kernels`] compiles their pipelines
 //! once per device; [`runner`] owns a scene's device buffers on a device handed to it and encodes
-//! whole runs of steps; [`support`] says what the device can run.
+//! whole runs of steps, which [`runs`] describes; [`support`] says what the device can run.
 //!
 //! Design, for real GPUs as much as for the CPU emulation CI has:
 //! - the state lives on the device; a run of many steps is encoded into one submission and the
@@ -25,9 +25,11 @@ pub mod kernels;
 pub mod micro_rates;
 pub mod rk_stages;
 pub mod runner;
+pub mod runs;
 pub mod support;
 
 pub use common::WORKGROUP;
 pub use device::{available, device, quiet_device_selection, GpuDevice};
 pub use kernels::Kernels;
-pub use runner::{AdaptiveReport, AdaptiveSteps, GpuModel, GpuRun, Peek, RunOutcome, UniformSteps};
+pub use runner::{GpuRun, Peek};
+pub use runs::{AdaptiveReport, AdaptiveSteps, GpuModel, RunOutcome, UniformSteps};
