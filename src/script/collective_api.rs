@@ -153,25 +153,17 @@ fn recorded(r: &RecorderHandle, name: &str, fix: &str) -> ScriptResult<(Vec<f64>
 
 /// Register the collective observables and estimators.
 pub fn register(engine: &mut Engine) {
+    for (name, p) in [
+        ("pair_correlation", PairPart::Density),
+        ("pair_polar", PairPart::Polar),
+        ("pair_nematic", PairPart::Nematic),
+    ] {
+        engine.register_fn(
+            name,
+            move |bins: INT, r_max: Dynamic| -> ScriptResult<Observable> { part(p, bins, &r_max) },
+        );
+    }
     engine
-        .register_fn(
-            "pair_correlation",
-            |bins: INT, r_max: Dynamic| -> ScriptResult<Observable> {
-                part(PairPart::Density, bins, &r_max)
-            },
-        )
-        .register_fn(
-            "pair_polar",
-            |bins: INT, r_max: Dynamic| -> ScriptResult<Observable> {
-                part(PairPart::Polar, bins, &r_max)
-            },
-        )
-        .register_fn(
-            "pair_nematic",
-            |bins: INT, r_max: Dynamic| -> ScriptResult<Observable> {
-                part(PairPart::Nematic, bins, &r_max)
-            },
-        )
         .register_fn(
             "pair_correlation",
             |s: &mut SceneHandle, bins: INT, r_max: Dynamic| -> ScriptResult<Map> {

@@ -149,14 +149,11 @@ fn closure(v: &Dynamic) -> ScriptResult<Closure> {
             describe(v)
         )));
     };
-    if let Some(k) = m
-        .keys()
-        .find(|k| !["rotation", "translation", "fitted"].contains(&k.as_str()))
-    {
-        return Err(script_error(format!(
-            "continuum closure: unknown key \"{k}\" (known: rotation, translation, fitted); {CLOSURE_FIX}"
-        )));
-    }
+    check_keys(
+        "continuum closure",
+        &m,
+        &["rotation", "translation", "fitted"],
+    )?;
     let coefficient = |key: &str| match m.get(key) {
         Some(x) => number(&format!("continuum closure {key}"), x),
         None => Ok(0.0),
