@@ -5,6 +5,11 @@ use super::kernel::{self, Component, Constants, Radial};
 use super::sphere::{monomial, monomials, Sphere};
 use crate::engine::fft3::{signed_mode, Fft3};
 use crate::engine::integrators::{OdeSystem, Problem};
+use crate::engine::parallel::{for_chunks_mut, map_indices, PARALLEL_GRID_POINTS};
+
+/// Cells × coefficients × orientation nodes from which a right-hand side's loop over cells runs
+/// on rayon's threads.
+const PARALLEL_CELL_TERMS: usize = 1 << 17;
 use crate::engine::thermal::RigidDiffusion;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
@@ -36,6 +41,14 @@ pub(super) struct Operator {
     pub(super) nn: Vec<Vec<f64>>,
     pub(super) fft: Fft3,
     pub(super) cells: usize,
+    /// Whether a right-hand side's loops over groups and coefficients (a transform each) run on
+    /// rayon's threads: the grid has [`PARALLEL_GRID_POINTS`] (a smaller one's transforms are
+    /// too short to hand out).
+    pub(super) parallel: bool,
+    /// Whether its loop over cells (B coefficients at every node of the orientation rule in
+    /// each) does: from [`PARALLEL_CELL_TERMS`] cells × B × nodes (~0.3 ms), which an 8³ grid
+    /// of degree 4 passes.
+    pub(super) cells_parallel: bool,
     /// The core and cutoff (m) of the kernel.
     pub(super) core: f64,
     pub(super) cutoff: f64,
@@ -166,6 +179,7 @@ impl Operator {
                     .collect()
             })
             .collect();
+        let cells_parallel = cells * bsz * sphere.node_count() >= PARALLEL_CELL_TERMS;
         Operator {
             sphere,
             comps,
@@ -180,6 +194,8 @@ impl Operator {
             nn,
             fft: Fft3::new(grid),
             cells,
+            parallel: cells >= PARALLEL_GRID_POINTS,
+            cells_parallel,
             core,
             cutoff,
         }
@@ -241,9 +257,12 @@ impl Operator {
             })
             .collect();
         let inv = 1.0 / cells as f64;
-        self.groups
-            .par_iter()
-            .map(|(_, _, comps)| {
+        map_indices(
+            self.groups.len(),
+            self.parallel,
+            || (),
+            |_, g| {
+                let comps = &self.groups[g].2;
                 let mut buf = vec![Complex64::default(); cells];
                 for &c in comps {
                     let comp = &self.comps[c];
@@ -262,8 +281,8 @@ impl Operator {
                 let mut spare = vec![Complex64::default(); cells];
                 self.fft.inverse(&mut buf, &mut spare);
                 buf.iter().map(|v| v.re * inv).collect()
-            })
-            .collect()
+            },
+        )
     }
 }
 
@@ -285,82 +304,86 @@ impl OdeSystem for Kinetic {
                 Some(op.terms_from_moments(&moments, p))
             };
             let block = |i: usize| &y[(p * b + i) * cells..(p * b + i + 1) * cells];
-            // Fluxes F_{i,a} = ∫ Y_i v_a f and turns R_i = ∫ f ṅ·∇Y_i at every cell, [i·4 + a].
-            let mut flux = vec![vec![0.0; cells]; 4 * b];
+            // Fluxes F_{i,a} = ∫ Y_i v_a f and turns R_i = ∫ f ṅ·∇Y_i at every cell, at
+            // [cell·4B + i·4 + a] (a cell's terms together, written by one thread).
+            let width = 4 * b;
+            let mut flux = vec![0.0; width * cells];
             if let Some(u) = &terms {
-                let per_cell: Vec<Vec<f64>> = (0..cells)
-                    .into_par_iter()
-                    .map_init(
-                        || (vec![0.0; nn], vec![[0.0; 6]; nn]),
-                        |(f, rates), cell| {
-                            let coef: Vec<f64> = (0..b).map(|i| block(i)[cell]).collect();
-                            op.sphere.evaluate(&coef, f);
-                            rates.iter_mut().for_each(|r| *r = [0.0; 6]);
-                            for (g, (o, at, _)) in op.groups.iter().enumerate() {
-                                let uv = u[g][cell];
-                                if uv != 0.0 {
-                                    for (r, a) in rates.iter_mut().zip(at) {
-                                        r[*o] += uv * a;
-                                    }
+                for_chunks_mut(
+                    &mut flux,
+                    width,
+                    op.cells_parallel,
+                    || (vec![0.0; nn], vec![[0.0; 6]; nn], vec![0.0; b]),
+                    |(f, rates, coef), cell, out| {
+                        coef.iter_mut()
+                            .enumerate()
+                            .for_each(|(i, c)| *c = block(i)[cell]);
+                        op.sphere.evaluate(coef, f);
+                        rates.iter_mut().for_each(|r| *r = [0.0; 6]);
+                        for (g, (o, at, _)) in op.groups.iter().enumerate() {
+                            let uv = u[g][cell];
+                            if uv != 0.0 {
+                                for (r, a) in rates.iter_mut().zip(at) {
+                                    r[*o] += uv * a;
                                 }
                             }
-                            let mut out = vec![0.0; 4 * b];
-                            for (j, (r, fj)) in rates.iter().zip(f.iter()).enumerate() {
-                                let n = op.sphere.nodes[j];
-                                let t = [r[3], r[4], r[5]];
-                                let along = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
-                                let turn: [f64; 3] =
-                                    std::array::from_fn(|d| -(t[d] - along * n[d]));
-                                let wf = op.sphere.weights[j] * fj;
-                                for i in 0..b {
-                                    let yv = op.sphere.value(i, j) * wf;
-                                    let g = op.sphere.gradients[i * nn + j];
-                                    out[4 * i] += yv * r[0];
-                                    out[4 * i + 1] += yv * r[1];
-                                    out[4 * i + 2] += yv * r[2];
-                                    out[4 * i + 3] +=
-                                        wf * (turn[0] * g[0] + turn[1] * g[1] + turn[2] * g[2]);
-                                }
+                        }
+                        for (j, (r, fj)) in rates.iter().zip(f.iter()).enumerate() {
+                            let n = op.sphere.nodes[j];
+                            let t = [r[3], r[4], r[5]];
+                            let along = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+                            let turn: [f64; 3] = std::array::from_fn(|d| -(t[d] - along * n[d]));
+                            let wf = op.sphere.weights[j] * fj;
+                            for i in 0..b {
+                                let yv = op.sphere.value(i, j) * wf;
+                                let g = op.sphere.gradients[i * nn + j];
+                                out[4 * i] += yv * r[0];
+                                out[4 * i + 1] += yv * r[1];
+                                out[4 * i + 2] += yv * r[2];
+                                out[4 * i + 3] +=
+                                    wf * (turn[0] * g[0] + turn[1] * g[1] + turn[2] * g[2]);
                             }
-                            out
-                        },
-                    )
-                    .collect();
-                for (cell, v) in per_cell.iter().enumerate() {
-                    for (q, x) in v.iter().enumerate() {
-                        flux[q][cell] = *x;
-                    }
-                }
+                        }
+                    },
+                );
             }
             // With noise: every coefficient's transform, for the diffusion terms.
             let hats: Option<Vec<Vec<Complex64>>> = op.diffusion.as_ref().map(|_| {
-                (0..b)
-                    .into_par_iter()
-                    .map(|i| {
+                map_indices(
+                    b,
+                    op.parallel,
+                    || (),
+                    |_, i| {
                         let mut spare = vec![Complex64::default(); cells];
                         let mut buf: Vec<Complex64> =
                             block(i).iter().map(|x| Complex64::new(*x, 0.0)).collect();
                         op.fft.forward(&mut buf, &mut spare);
                         buf
-                    })
-                    .collect()
+                    },
+                )
             });
-            let out: Vec<Vec<f64>> = (0..b)
-                .into_par_iter()
-                .map(|i| {
+            let out: Vec<Vec<f64>> = map_indices(
+                b,
+                op.parallel,
+                || (),
+                |_, i| {
                     let mut spare = vec![Complex64::default(); cells];
-                    let to_k = |v: &[f64], spare: &mut Vec<Complex64>| {
-                        let mut buf: Vec<Complex64> =
-                            v.iter().map(|x| Complex64::new(*x, 0.0)).collect();
+                    // Flux term q of every cell, transformed.
+                    let to_k = |q: usize, spare: &mut Vec<Complex64>| {
+                        let mut buf: Vec<Complex64> = flux[q..]
+                            .iter()
+                            .step_by(width)
+                            .map(|x| Complex64::new(*x, 0.0))
+                            .collect();
                         op.fft.forward(&mut buf, spare);
                         buf
                     };
                     let mut acc = vec![Complex64::default(); cells];
                     if terms.is_some() {
-                        let fx = to_k(&flux[4 * i], &mut spare);
-                        let fy = to_k(&flux[4 * i + 1], &mut spare);
-                        let fz = to_k(&flux[4 * i + 2], &mut spare);
-                        let r = to_k(&flux[4 * i + 3], &mut spare);
+                        let fx = to_k(4 * i, &mut spare);
+                        let fy = to_k(4 * i + 1, &mut spare);
+                        let fz = to_k(4 * i + 2, &mut spare);
+                        let r = to_k(4 * i + 3, &mut spare);
                         for (k, a) in acc.iter_mut().enumerate() {
                             let w = op.waves[k];
                             let div = w[0] * fx[k] + w[1] * fy[k] + w[2] * fz[k];
@@ -400,8 +423,8 @@ impl OdeSystem for Kinetic {
                     op.fft.inverse(&mut acc, &mut spare);
                     let inv = 1.0 / cells as f64;
                     acc.iter().map(|v| v.re * inv).collect()
-                })
-                .collect();
+                },
+            );
             for (i, v) in out.into_iter().enumerate() {
                 dy[(p * b + i) * cells..(p * b + i + 1) * cells].copy_from_slice(&v);
             }
