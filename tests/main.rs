@@ -5,18 +5,26 @@
 
 mod common;
 
-/// Lavapipe, the Vulkan device of machines without a GPU (CI's), runs every dispatch on a pool of
-/// as many threads as there are cores. Beside the suite's own test threads on every core those
-/// pools wait on each other at each of the GPU tests' many small dispatches, in the kernel
-/// (`LP_NUM_THREADS=0` makes the Fig-1 parity test 18 s → 5.5 s, most of the difference system
-/// time). So the suite asks lavapipe to run dispatches on the calling thread, unless the caller
-/// chose a number. It is set in the binary's initialiser, before `main` starts a thread: setting
-/// the environment while another thread may read it is not sound. A real GPU ignores it.
+/// Settings of the suite's environment, made in the binary's initialiser before `main` starts
+/// a thread (setting the environment while another thread may read it is not sound), each only
+/// where the caller has not chosen:
+/// - `RUST_TEST_THREADS`: two test threads more than cores. A dozen tests spend most of their
+///   time waiting (on a child process, a socket, a browser, a terminal, a timer), and with one
+///   thread per core a core idles whenever one of them runs (the getting-started chapter has the
+///   suite's times by thread count). `--test-threads` still overrides.
+/// - `LP_NUM_THREADS=0`: lavapipe, the Vulkan device of machines without a GPU (CI's), runs
+///   every dispatch on a pool of as many threads as cores; beside the test threads those pools
+///   wait on each other in the kernel at each of the GPU tests' many small dispatches, which
+///   then cost several times their work, most of it system time. A real GPU ignores it.
 #[cfg(target_os = "linux")]
 #[used]
 #[link_section = ".init_array"]
-static LAVAPIPE_ON_THE_CALLING_THREAD: extern "C" fn() = {
+static SUITE_ENVIRONMENT: extern "C" fn() = {
     extern "C" fn init() {
+        if std::env::var_os("RUST_TEST_THREADS").is_none() {
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            std::env::set_var("RUST_TEST_THREADS", (cores + 2).to_string());
+        }
         if std::env::var_os("LP_NUM_THREADS").is_none() {
             std::env::set_var("LP_NUM_THREADS", "0");
         }
