@@ -1,6 +1,7 @@
 //! Bulk suspensions of the averaged model (issue 32): neighbour lists against the all-pairs rows
 //! while swimmers move, cross faces and are relisted; the suspension stepper's order, its
-//! agreement with fine RK4, its contacts, guards, interrupts and save/load mid-run.
+//! agreement with a tight Dormand-Prince reference, its contacts, guards, interrupts and
+//! save/load mid-run.
 
 use nalgebra::Vector3;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -159,29 +160,27 @@ fn run(mut s: Scene, spec: IntegratorSpec, periods: f64) -> Simulation {
     sim
 }
 
-// The suspension stepper against RK4 at T/256 over 20 periods. The reference's own error is
-// bounded by its difference from RK4 at T/128: the pair in contact makes RK4 converge late, but
-// its error falls at least twofold per halving from T/128 on (measured: 3.2e-7 from T/64 to
-// T/128, 6.3e-9 from T/128 to T/256), so the T/256 reference is within that difference, below
-// 1e-8, well under a tenth of the smallest error compared below (8e-7 at tol 1e-4). At the default
-// tolerance the stepper is within 1e-3 of the RMS displacement (the issue's bar), and the error
-// falls with tol.
+// The suspension stepper against Dormand-Prince at rtol 1e-11 over 20 periods. The reference's
+// own error is bounded by its difference from rtol 1e-10 (measured 2.5e-11; the error falls with
+// the tolerance: both lie within 5e-10 of RK4 at T/256, which is itself within RK4's 6.3e-9
+// difference from T/128 there), below 1e-9, well under a tenth of the smallest error compared
+// below (8e-7 at tol 1e-4). At the default tolerance the stepper is within 1e-3 of the RMS
+// displacement (the issue's bar), and the error falls with tol.
 #[test]
-fn the_suspension_stepper_converges_to_fine_rk4() {
-    let period = 2.0 * std::f64::consts::PI / Dumbbell::default().omega;
+fn the_suspension_stepper_converges_to_a_tight_reference() {
     let state = |sim: &Simulation| sim.scene().raw_state().0.to_vec();
     let coarser = state(&run(
         contact_scene(),
-        IntegratorSpec::rk4(period / 128.0).unwrap(),
+        IntegratorSpec::dopri5(1e-10).unwrap(),
         20.0,
     ));
     let reference = state(&run(
         contact_scene(),
-        IntegratorSpec::rk4(period / 256.0).unwrap(),
+        IntegratorSpec::dopri5(1e-11).unwrap(),
         20.0,
     ));
     let reference_error = displacement_error(&reference, &coarser);
-    assert!(reference_error < 1e-8, "rk4 T/256: {reference_error:e}");
+    assert!(reference_error < 1e-9, "dopri5 1e-11: {reference_error:e}");
     let mut rows = Vec::new();
     for tol in [1e-2, 1e-3, 1e-4] {
         let sim = run(
