@@ -84,6 +84,9 @@ impl WallVelocities {
     }
 }
 
+/// 1/3, rounded once.
+const THIRD: f64 = 1.0 / 3.0;
+
 /// Row i's data for [`pair_terms`].
 #[derive(Clone, Copy)]
 struct Row {
@@ -124,22 +127,24 @@ fn pair_terms(
     let t = r3.mul_add(h * dh, r3r3 * aj2);
     let s = 3.0f64.mul_add(t, aa);
     // The coefficients of each polynomial in q² (A = q (a0 + q² (a1 + q² (a2 + q² a3))), and so
-    // on), term by term those of `wall_correction`.
-    let a1 = (hh6 - r3h - sum2) / 3.0;
-    let a2c = 2.0 * s / 3.0;
-    let a3 = -10.0 * r3r3 * aa / 3.0;
+    // on), term by term those of `wall_correction`; its divisions by 3 are products with
+    // constants here (a division costs the vector unit several times a product).
+    let raa = r3r3 * aa;
+    let a1 = (hh6 - r3h - sum2) * THIRD;
+    let a2c = s * (2.0 * THIRD);
+    let a3 = raa * (-10.0 * THIRD);
     let b1 = r3h - hh6 + sum2;
-    let b2 = -10.0 * s / 3.0;
-    let b3 = 70.0 * r3r3 * aa / 3.0;
+    let b2 = s * (-10.0 * THIRD);
+    let b3 = raa * (70.0 * THIRD);
     let c0 = 2.0 * h - r3;
     let c1 = r3h.mul_add(h - r3, r3 * (ai2 - 3.0 * aj2)) - 2.0 * h * dh;
     let c2 = 10.0 * r3 * (t + aa);
-    let c3 = -70.0 * r3r3 * r3 * aa / 3.0;
+    let c3 = -b3 * r3;
     let d1 = r3h.mul_add(r3 - h, r3 * sum2) + 2.0 * h * dh;
-    let e1 = -(3.0 * r3r3 - r3h + sum2 + hh6) / 3.0;
+    let e1 = -(3.0 * r3r3 - r3h + sum2 + hh6) * THIRD;
     let e2 = (r3h * r3).mul_add(h - r3, r3r3 * (ai2 - 5.0 * aj2)) - r3h * dh - 2.0 * aa;
     let e3 = 10.0 * r3r3 * (t + 2.0 * aa);
-    let e4 = -70.0 * r3r3 * r3r3 * aa / 3.0;
+    let e4 = c3 * r3;
     let q3 = q * q2;
     let a_ = q * q2.mul_add(q2.mul_add(q2.mul_add(a3, a2c), a1), -1.0);
     let b_ = q3 * q2.mul_add(q2.mul_add(q2.mul_add(b3, b2), b1), -1.0);

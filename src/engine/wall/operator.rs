@@ -18,9 +18,22 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// The number of row chunks of the parallel pair terms: fixed, so that their sums add up in the
-/// same order on any number of threads; enough to keep a few dozen cores busy.
+/// The most row chunks of the parallel pair terms: enough to keep a few dozen cores busy.
 const ROW_CHUNKS: usize = 32;
+
+/// The fewest pairs in a chunk of the parallel pair terms: ~15 µs of work at ~4 ns a pair, well
+/// above what handing a chunk to a thread costs and the O(n) of zeroing and adding its buffer.
+const MIN_CHUNK_PAIRS: usize = 4096;
+
+/// The number of row chunks of the pair terms of `n` spheres: one where a product is too short
+/// to share (then it runs on the caller's thread), at most [`ROW_CHUNKS`]. It depends on `n`
+/// alone, so the chunks' sums add up in the same order on any number of threads.
+fn chunk_count(n: usize) -> usize {
+    if n < PARALLEL_IMAGE_SPHERES {
+        return 1;
+    }
+    (n * n.saturating_sub(1) / 2 / MIN_CHUNK_PAIRS).clamp(1, ROW_CHUNKS)
+}
 
 /// The first rows of `chunks` contiguous chunks of the half-loop over `n` rows (row i holds the
 /// n − 1 − i pairs (i, j > i)), each with about the same number of pairs, and `n` at the end.
@@ -36,6 +49,28 @@ fn row_chunks(n: usize, chunks: usize) -> Vec<usize> {
     }
     starts.push(n);
     starts
+}
+
+/// The wall's pair terms of the spheres `soa`, in units of 1/(8πμ): one buffer per chunk of rows
+/// ([`chunk_count`]), the chunks on rayon's threads where there are several; the caller adds the
+/// buffers in chunk order, so the result does not depend on the threads or how the work was
+/// stolen.
+fn wall_pair_terms(soa: &WallSpheres) -> Vec<WallVelocities> {
+    let n = soa.len();
+    let chunks = chunk_count(n);
+    if chunks == 1 {
+        let mut u = WallVelocities::zeros(n);
+        wall_rows(soa, 0, n, &mut u);
+        return vec![u];
+    }
+    row_chunks(n, chunks)
+        .par_windows(2)
+        .map(|w| {
+            let mut u = WallVelocities::zeros(n);
+            wall_rows(soa, w[0], w[1], &mut u);
+            u
+        })
+        .collect()
 }
 
 /// Spheres in a fluid of viscosity `mu` above the no-slip plane of `wall`.
@@ -214,31 +249,22 @@ impl MobilityOperator for WallMobility {
         self.damped.clear();
         self.damped
             .extend(forces.iter().zip(&self.damping).map(|(f, b)| f * *b));
-        // Open space's pairs at the lifted positions (equal to the true ones without damping;
-        // the open tensor is invariant under the common shift by the wall's height).
-        self.open
-            .interaction_velocities(&self.lifted, radii, &self.damped, out);
-        // The wall's pair terms (in units of 1/(8πμ)), then each sphere's own correction.
+        // The wall's pair terms (in units of 1/(8πμ)), then each sphere's own correction, and
+        // open space's pairs at the lifted positions (equal to the true ones without damping;
+        // the open tensor is invariant under the common shift by the wall's height). The two
+        // sums are independent: from PARALLEL_IMAGE_SPHERES spheres on they run side by side
+        // on rayon's threads (each as it would alone, so the result does not depend on it).
         self.soa.clear();
         for ((x, &a), f) in self.lifted.iter().zip(radii).zip(&self.damped) {
             self.soa.push(x, self.image_radius(a), f);
         }
-        let soa = &self.soa;
-        let parts: Vec<WallVelocities> = if n >= PARALLEL_IMAGE_SPHERES {
-            // Fixed chunks of rows, each summed into its own buffer, the buffers added in chunk
-            // order: the result does not depend on the threads or how the work was stolen.
-            row_chunks(n, ROW_CHUNKS)
-                .par_windows(2)
-                .map(|w| {
-                    let mut u = WallVelocities::zeros(n);
-                    wall_rows(soa, w[0], w[1], &mut u);
-                    u
-                })
-                .collect()
+        let (open, lifted, damped, soa) = (&mut self.open, &self.lifted, &self.damped, &self.soa);
+        let mut open_pairs = || open.interaction_velocities(lifted, radii, damped, out);
+        let parts = if n >= PARALLEL_IMAGE_SPHERES {
+            rayon::join(open_pairs, || wall_pair_terms(soa)).1
         } else {
-            let mut u = WallVelocities::zeros(n);
-            wall_rows(soa, 0, n, &mut u);
-            vec![u]
+            open_pairs();
+            wall_pair_terms(soa)
         };
         let scale = 1.0 / (8.0 * PI * self.mu);
         for (i, o) in out.iter_mut().enumerate() {
@@ -366,8 +392,8 @@ mod tests {
     /// The product W F against the matrix's (M − D) F, M from the scalar blocks (`wall_correction`
     /// and the self series): RPY and Oseen, unequal radii, a third of the spheres below one
     /// radius (damped, lifted), sizes not a multiple of the lane width on the serial path, the
-    /// parallel chunks (from PARALLEL_IMAGE_SPHERES) and open space's row kernel (from
-    /// FAST_KERNEL_SPHERES). Tolerance 1e-12 of the largest M F: both sides add the same terms in
+    /// open and wall sums side by side (from PARALLEL_IMAGE_SPHERES), open space's row kernel
+    /// (from FAST_KERNEL_SPHERES) and the wall's terms in several chunks (131 spheres: two). Tolerance 1e-12 of the largest M F: both sides add the same terms in
     /// another order (lanes, chunks, Horner chains, AVX-512's 1/r within 2 ulp), and the matrix
     /// side's drag, up to the largest M F, is subtracted back out.
     #[test]
@@ -381,7 +407,8 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let sizes = [5, 13, PARALLEL_IMAGE_SPHERES + 7, FAST_KERNEL_SPHERES + 13];
+        let sizes = [5, 13, PARALLEL_IMAGE_SPHERES + 7, FAST_KERNEL_SPHERES + 13, 131];
+        assert!(chunk_count(131) == 2 && chunk_count(FAST_KERNEL_SPHERES + 13) == 1);
         for kind in [Mobility::Rpy, Mobility::Oseen] {
             for n in sizes {
                 let mut op = WallMobility::new(mu, kind, Wall::at(z0).expect("a finite wall"));
