@@ -301,7 +301,7 @@ fn the_error_stays_within_ten_times_the_tolerance() {
 fn close_pairs_keep_the_tolerance() {
     // Two swimmers 2ℓ and 3ℓ apart, not aligned, 300 periods, against dopri5(1e-9): it differs
     // from dopri5(1e-11) by 5e-12 (2ℓ) and 1.4e-11 (3ℓ) in this error measure, ≤ 6% of the
-    // smallest error measured below and 1e-4 of the smallest bound. The error within 10× tol
+    // smallest error measured below and 1.4e-4 of the smallest bound. The error within 10× tol
     // down to 1e-6 at 2ℓ and 1e-8 at 3ℓ.
     // Slopes of a fixed second degree had an error floor here, 1.4e-5 at 2ℓ and 2.2e-7 at 3ℓ
     // whatever the tolerance (their own truncation error, measured by the degree-3 … 8 slopes

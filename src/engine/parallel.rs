@@ -1,10 +1,9 @@
 //! From how many spheres a pair sum runs on rayon's threads, and from how many points a grid's
 //! passes do; [`for_chunks_mut`] and [`map_indices`] run a loop on those threads or on the
-//! caller's. One product must be long enough
-//! that rayon's dispatch (a few µs) is a negligible share of it; how many spheres that takes
-//! follows from the cost of one pair, so the threshold differs by the kind of pair sum (the
-//! timings are in the book's design notes, "When the pair kernels take over, and when rows go
-//! parallel").
+//! caller's. One product must be long enough that rayon's dispatch (a few µs) is a negligible
+//! share of it; how many spheres that takes follows from the cost of one pair, so the threshold
+//! differs by the kind of pair sum (the timings are in the book's design notes, "When the pair
+//! kernels take over, and when rows go parallel").
 
 /// Pairs in open space (the RPY or Oseen rows, steric forces, gaps): a pair costs a few dozen
 /// flops, and a product of 256 spheres about 0.3 ms.
@@ -12,17 +11,17 @@ pub const PARALLEL_SPHERES: usize = 256;
 
 /// Pairs summed with their images (the wall's Blake image terms; the box's Ewald sums over
 /// images and waves): a pair costs several open-space pairs, so a product is long enough from
-/// fewer spheres (the wall's terms about 0.1 ms at 64).
+/// fewer spheres. Above a wall, open space's pairs and the wall's run side by side from here.
 pub const PARALLEL_IMAGE_SPHERES: usize = 64;
 
 /// Points of a grid from which an FFT's passes (rows along an axis, transposes) run on rayon's
 /// threads. Each pass is one parallel call; on a smaller grid a pass takes a few µs, about what
 /// handing it to the pool and waking its threads costs, and the woken threads spin on the other
-/// cores while the caller goes on (16³ and up in parallel, 8 × 16 × 16 not).
+/// cores while the caller goes on.
 pub const PARALLEL_GRID_POINTS: usize = 4096;
 
 /// `f(state, k, chunk)` for every chunk `k` of `chunk` items of `data`, on rayon's threads where
-/// `parallel` (each thread's `state` from `init`), else in order on the caller's thread.
+/// `parallel` (each job's `state` from `init`), else in order on the caller's thread.
 pub fn for_chunks_mut<T, S, I, F>(data: &mut [T], chunk: usize, parallel: bool, init: I, f: F)
 where
     T: Send,
@@ -43,7 +42,7 @@ where
 }
 
 /// `f(state, i)` for i in 0..n, collected in order: on rayon's threads where `parallel` (each
-/// thread's `state` from `init`), else on the caller's.
+/// job's `state` from `init`), else on the caller's.
 pub fn map_indices<T, S, I, F>(n: usize, parallel: bool, init: I, f: F) -> Vec<T>
 where
     T: Send,

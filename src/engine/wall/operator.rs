@@ -21,12 +21,12 @@ use std::f64::consts::PI;
 /// The most row chunks of the parallel pair terms: enough to keep a few dozen cores busy.
 const ROW_CHUNKS: usize = 32;
 
-/// The fewest pairs in a chunk of the parallel pair terms: ~15 µs of work at ~4 ns a pair, well
-/// above what handing a chunk to a thread costs and the O(n) of zeroing and adding its buffer.
+/// The fewest pairs in a chunk of the parallel pair terms: enough work that handing a chunk to a
+/// thread, and zeroing and adding its buffer (O(n)), are a small share of it.
 const MIN_CHUNK_PAIRS: usize = 4096;
 
 /// The number of row chunks of the pair terms of `n` spheres: one where a product is too short
-/// to share (then it runs on the caller's thread), at most [`ROW_CHUNKS`]. It depends on `n`
+/// to share (then it runs in one piece on one thread), at most [`ROW_CHUNKS`]. It depends on `n`
 /// alone, so the chunks' sums add up in the same order on any number of threads.
 fn chunk_count(n: usize) -> usize {
     if n < PARALLEL_IMAGE_SPHERES {
@@ -393,9 +393,10 @@ mod tests {
     /// and the self series): RPY and Oseen, unequal radii, a third of the spheres below one
     /// radius (damped, lifted), sizes not a multiple of the lane width on the serial path, the
     /// open and wall sums side by side (from PARALLEL_IMAGE_SPHERES), open space's row kernel
-    /// (from FAST_KERNEL_SPHERES) and the wall's terms in several chunks (131 spheres: two). Tolerance 1e-12 of the largest M F: both sides add the same terms in
-    /// another order (lanes, chunks, Horner chains, AVX-512's 1/r within 2 ulp), and the matrix
-    /// side's drag, up to the largest M F, is subtracted back out.
+    /// (from FAST_KERNEL_SPHERES) and the wall's terms in several chunks (131 spheres: two).
+    /// Tolerance 1e-12 of the largest M F: both sides add the same terms in another order
+    /// (lanes, chunks, Horner chains, AVX-512's 1/r within 2 ulp), and the matrix side's drag,
+    /// up to the largest M F, is subtracted back out.
     #[test]
     fn product_equals_the_matrix_minus_drag() {
         let mu = 1e-3;
@@ -407,7 +408,13 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let sizes = [5, 13, PARALLEL_IMAGE_SPHERES + 7, FAST_KERNEL_SPHERES + 13, 131];
+        let sizes = [
+            5,
+            13,
+            PARALLEL_IMAGE_SPHERES + 7,
+            FAST_KERNEL_SPHERES + 13,
+            131,
+        ];
         assert!(chunk_count(131) == 2 && chunk_count(FAST_KERNEL_SPHERES + 13) == 1);
         for kind in [Mobility::Rpy, Mobility::Oseen] {
             for n in sizes {
