@@ -43,10 +43,10 @@ fn run_without_a_file_runs_the_built_in_experiment() {
     assert!(out.contains("collective drift per period"));
 }
 
-/// Settings that shrink a script's quick mode further where it is too long for the suite. The
-/// density study's `--quick` runs every state of the study with the spring model (about three
-/// minutes on two cores); here one state, which takes every code path but the other states'
-/// parameters, keeps the suite short.
+/// Settings that shrink a script's quick mode further where it is long for the suite; each keeps
+/// every code path of the script. The density study's `--quick` runs every state of the study
+/// with the spring model (about three minutes on two cores); here one state with one seed. The
+/// bulk demo's quick mode runs 300 swimmers in each of its four cases; here 100.
 fn smaller(path: &std::path::Path) -> Vec<&'static str> {
     if path.ends_with("study/densities.rhai") {
         vec![
@@ -56,7 +56,11 @@ fn smaller(path: &std::path::Path) -> Vec<&'static str> {
             "kinds=asymmetric",
             "--set",
             "phases=two",
+            "--set",
+            "seeds=1",
         ]
+    } else if path.ends_with("demos/bulk.rhai") {
+        vec!["--set", "n=100"]
     } else {
         vec![]
     }
