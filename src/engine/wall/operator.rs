@@ -29,9 +29,6 @@ const MIN_CHUNK_PAIRS: usize = 4096;
 /// to share (then it runs in one piece on one thread), at most [`ROW_CHUNKS`]. It depends on `n`
 /// alone, so the chunks' sums add up in the same order on any number of threads.
 fn chunk_count(n: usize) -> usize {
-    if n < PARALLEL_IMAGE_SPHERES {
-        return 1;
-    }
     (n * n.saturating_sub(1) / 2 / MIN_CHUNK_PAIRS).clamp(1, ROW_CHUNKS)
 }
 
