@@ -8,8 +8,10 @@
 //!
 //! How K is met depends on what a block costs ([`Route`]):
 //! - a few swimmers outside a box: K from the boundary's blocks, Gaussian elimination;
-//! - open space: K from the pair coefficients, contracted with the orientations as it is filled
-//!   (O(S²), the cost of about one mobility product), then conjugate gradients on the matrix;
+//! - open space: K from the pair coefficients, contracted with the orientations as it is filled,
+//!   its part on and below the diagonal alone (K is symmetric: S²/2 entries of four sphere pairs
+//!   each, about the cost of one mobility product), then conjugate gradients on the matrix, whose
+//!   products read that part alone;
 //! - a periodic box (whose blocks are whole Ewald sums), a wall (whose products run in vector
 //!   lanes, and whose blocks do not) and beyond [`DENSE_MATRIX_UP_TO`] swimmers: conjugate
 //!   gradients over mobility products (K T is one product), no matrix of K itself.
@@ -24,9 +26,9 @@
 use super::boundary::Boundary;
 use super::cg::{cg, CgVectors};
 use super::mobility::self_mobility;
-use super::parallel::PARALLEL_SPHERES;
+use super::parallel::{map_indices, PARALLEL_SPHERES};
 use super::periodic::{separation, PeriodicBox};
-use super::simd::vector_dispatch;
+use super::simd::{lane_sum, vector_dispatch, LANES};
 use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -228,7 +230,7 @@ impl Tensions {
         let k = &*k;
         let mut apply = |p: &DVector<f64>, q: &mut DVector<f64>| {
             if !by_products {
-                k.mul_to(p, q);
+                lower_mul_to(k, p, q);
                 return;
             }
             for (s, ns) in n.iter().enumerate() {
@@ -256,7 +258,7 @@ impl Tensions {
                     inner,
                     goal,
                     MAX_ITERATIONS.min(r.len() + 50),
-                    |p, q| k.mul_to(p, q),
+                    |p, q| lower_mul_to(k, p, q),
                     // Jacobi on K's own diagonal, read in place.
                     |r, z| {
                         for (s, (zs, rs)) in z.iter_mut().zip(r.iter()).enumerate() {
@@ -324,9 +326,10 @@ struct KLanes {
     inv_l: [f64; 3],
 }
 
-/// Column τ of K for every σ by the far-apart pair tensor (c_I = o + f, c_rr = o − 3f with
-/// o = 1/(8πμd), f = (a_i² + a_j²) o/(3d²)), and in `margin` the least d² − (a_i + a_j)² of the
-/// four sphere pairs (≤ 0 where a pair overlaps and the far form does not hold).
+/// Column τ of K for σ = τ, τ + 1, … (its part on and below the diagonal, `col[0]` the
+/// diagonal) by the far-apart pair tensor (c_I = o + f, c_rr = o − 3f with o = 1/(8πμd),
+/// f = (a_i² + a_j²) o/(3d²)), and in `margin` the least d² − (a_i + a_j)² of the four sphere
+/// pairs (≤ 0 where a pair overlaps and the far form does not hold).
 #[inline(always)]
 fn k_column_body(l: &KLanes, tau: usize, col: &mut [f64], margin: &mut [f64]) {
     let t1 = [l.p1[0][tau], l.p1[1][tau], l.p1[2][tau]];
@@ -334,7 +337,8 @@ fn k_column_body(l: &KLanes, tau: usize, col: &mut [f64], margin: &mut [f64]) {
     let nt = [l.n[0][tau], l.n[1][tau], l.n[2][tau]];
     let (tq1, tq2) = (l.q1[tau], l.q2[tau]);
     let (c8, finite) = (l.c8, l.finite);
-    for (sg, (entry, least)) in col.iter_mut().zip(margin.iter_mut()).enumerate() {
+    for (row, (entry, least)) in col.iter_mut().zip(margin.iter_mut()).enumerate() {
+        let sg = tau + row;
         let ns = [l.n[0][sg], l.n[1][sg], l.n[2][sg]];
         let nn = ns[0] * nt[0] + ns[1] * nt[1] + ns[2] * nt[2];
         let s1 = [l.p1[0][sg], l.p1[1][sg], l.p1[2][sg]];
@@ -421,17 +425,20 @@ fn fill_open_pairs(
         }
         sum
     };
+    // Only the part on and below the diagonal: K is symmetric, and its products read that part
+    // alone ([`lower_mul_to`]).
     let column = |tau: usize, col: &mut [f64], margin: &mut Vec<f64>| {
-        margin.resize(count, 0.0);
-        k_column(&lanes, tau, col, margin);
-        for (sg, (entry, m)) in col.iter_mut().zip(margin.iter()).enumerate() {
-            if sg == tau || m.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                *entry = exact(sg, tau);
+        let lower = &mut col[tau..];
+        margin.resize(lower.len(), 0.0);
+        k_column(&lanes, tau, lower, margin);
+        for (row, (entry, m)) in lower.iter_mut().zip(margin.iter()).enumerate() {
+            if row == 0 || m.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                *entry = exact(tau + row, tau);
             }
         }
     };
     let data = k.as_mut_slice();
-    if 2 * count >= PARALLEL_SPHERES / 2 {
+    if 2 * count >= PARALLEL_SPHERES {
         data.par_chunks_mut(count)
             .enumerate()
             .for_each_init(Vec::new, |margin, (tau, col)| column(tau, col, margin));
@@ -441,6 +448,87 @@ fn fill_open_pairs(
             column(tau, col, &mut margin);
         }
     }
+}
+
+/// q = K p for a symmetric K of which only the part on and below the diagonal is read (the part
+/// above may hold anything): each column's lower part once, as a dot product for q_τ and an axpy
+/// for the rows below it.
+///
+/// A large K is taken in runs of columns of about [`LOWER_PRODUCT_RUN`] entries each, on rayon's
+/// threads, each into a vector of its own, and those are added in order: how many runs there are
+/// depends on S alone, so the result does not depend on the threads.
+fn lower_mul_to(k: &DMatrix<f64>, p: &DVector<f64>, q: &mut DVector<f64>) {
+    let count = p.len();
+    let (k, p, q) = (k.as_slice(), p.as_slice(), q.as_mut_slice());
+    let entries = count * (count + 1) / 2;
+    let runs = (entries / LOWER_PRODUCT_RUN).clamp(1, 16);
+    if runs == 1 {
+        return lower_product(k, p, q, 0..count);
+    }
+    // Column boundaries that give each run about an equal share of the entries.
+    let mut bounds = vec![0];
+    let mut taken = 0;
+    for tau in 0..count {
+        taken += count - tau;
+        if taken * runs >= entries * bounds.len() && bounds.len() < runs {
+            bounds.push(tau + 1);
+        }
+    }
+    bounds.push(count);
+    let parts = map_indices(
+        bounds.len() - 1,
+        true,
+        || (),
+        |_, r| {
+            let mut part = vec![0.0; count];
+            lower_product(k, p, &mut part, bounds[r]..bounds[r + 1]);
+            part
+        },
+    );
+    q.fill(0.0);
+    for part in &parts {
+        for (qs, v) in q.iter_mut().zip(part) {
+            *qs += v;
+        }
+    }
+}
+
+/// Entries of K's lower part per run of columns in [`lower_mul_to`] (runs from 512 rows): a run
+/// reads 512 kB, tens of µs, far more than handing it to rayon's pool costs.
+const LOWER_PRODUCT_RUN: usize = 1 << 16;
+
+/// q = the columns `columns` of [`lower_mul_to`]'s product on the column-major entries `k` of an
+/// S×S matrix (q is zeroed first).
+#[inline(always)]
+fn lower_product_body(k: &[f64], p: &[f64], q: &mut [f64], columns: std::ops::Range<usize>) {
+    let count = p.len();
+    q.fill(0.0);
+    for tau in columns {
+        let col = &k[tau * count..(tau + 1) * count];
+        let (diag, below, rest) = (col[tau], &col[tau + 1..], &p[tau + 1..]);
+        let pt = p[tau];
+        for (qs, ks) in q[tau + 1..].iter_mut().zip(below) {
+            *qs += ks * pt;
+        }
+        // The dot product in lanes (separate sums, so that it vectorises), then the tail.
+        let mut lanes = [0.0; LANES];
+        let (blocks, tail) = below.split_at(below.len() / LANES * LANES);
+        for (kb, pb) in blocks.chunks_exact(LANES).zip(rest.chunks_exact(LANES)) {
+            for l in 0..LANES {
+                lanes[l] += kb[l] * pb[l];
+            }
+        }
+        let mut dot = diag * pt + lane_sum(&lanes);
+        for (ks, ps) in tail.iter().zip(&rest[blocks.len()..]) {
+            dot += ks * ps;
+        }
+        q[tau] += dot;
+    }
+}
+
+vector_dispatch! {
+    /// [`lower_product_body`] in the widest vector unit present.
+    fn lower_product(k: &[f64], p: &[f64], q: &mut [f64], columns: std::ops::Range<usize>) = lower_product_body;
 }
 
 /// The tensions by Gaussian elimination of K (from blocks) against −rate, into `rate`; NaN where
@@ -498,6 +586,32 @@ mod tests {
     use crate::engine::ewald::Ewald;
     use crate::engine::mobility::Mobility;
     use crate::engine::periodic::PeriodicBox;
+
+    /// The product from K's lower part equals the full matrix's, whatever lies above the
+    /// diagonal, serially and in runs of columns (from 512 rows): to the rounding of sums of a
+    /// few hundred terms of either sign.
+    #[test]
+    fn the_lower_product_is_the_symmetric_matrix_applied() {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        for count in [1, 7, 8, 9, 300, 600] {
+            let mut k = DMatrix::from_fn(count, count, |_, _| rng.uniform() - 0.5);
+            k = &k + k.transpose();
+            let p = DVector::from_fn(count, |_, _| rng.uniform() - 0.5);
+            let want = &k * &p;
+            for col in 1..count {
+                for row in 0..col {
+                    k[(row, col)] = f64::NAN;
+                }
+            }
+            let mut got = DVector::zeros(count);
+            lower_mul_to(&k, &p, &mut got);
+            let err = (&got - &want).amax();
+            assert!(
+                got.iter().all(|v| v.is_finite()) && err < 1e-12,
+                "{count} rows: error {err:e}"
+            );
+        }
+    }
 
     #[test]
     fn elimination_solves_a_pivoting_system() {
@@ -570,21 +684,32 @@ mod tests {
     /// residual times K's condition number (tens here, where spheres come within a diameter).
     #[test]
     fn every_route_gives_the_eliminated_tensions() {
-        for mobility in [Mobility::Rpy, Mobility::Oseen] {
-            let (mut spheres, swimmers, n, rate) = dumbbells(40, 40e-6, mobility);
-            let mut want = rate.clone();
-            Tensions::by(Route::Eliminate, 40).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
-            for route in [Route::OpenPairs, Route::Products] {
-                let mut solver = Tensions::by(route, 40);
-                // Twice: the second solve starts from the first's tensions.
-                for _ in 0..2 {
-                    let mut got = rate.clone();
-                    solver.solve(&mut spheres, &swimmers, &n, 0.0, &mut got);
-                    let err = (&got - &want).amax() / want.amax();
-                    assert!(err < 1e-9, "{mobility:?} {route:?}: relative error {err:e}");
-                }
-                assert_eq!(solver.route(), route);
+        // 520 swimmers at the same density: K filled on rayon's threads (from 128) and its
+        // products in runs of columns (from 512).
+        for (count, side) in [(40, 40e-6), (520, 94e-6)] {
+            for mobility in [Mobility::Rpy, Mobility::Oseen] {
+                routes_agree(count, side, mobility);
             }
+        }
+    }
+
+    fn routes_agree(count: usize, side: f64, mobility: Mobility) {
+        let (mut spheres, swimmers, n, rate) = dumbbells(count, side, mobility);
+        let mut want = rate.clone();
+        Tensions::by(Route::Eliminate, count).solve(&mut spheres, &swimmers, &n, 0.0, &mut want);
+        for route in [Route::OpenPairs, Route::Products] {
+            let mut solver = Tensions::by(route, count);
+            // Twice: the second solve starts from the first's tensions.
+            for _ in 0..2 {
+                let mut got = rate.clone();
+                solver.solve(&mut spheres, &swimmers, &n, 0.0, &mut got);
+                let err = (&got - &want).amax() / want.amax();
+                assert!(
+                    err < 1e-9,
+                    "{count} swimmers, {mobility:?} {route:?}: relative error {err:e}"
+                );
+            }
+            assert_eq!(solver.route(), route);
         }
     }
 
