@@ -97,25 +97,18 @@ struct Row {
     f: [f64; 3],
 }
 
-/// 8πμ (W_ij F_j, W_ji F_i) for row `p` = i and partner j at (`x`, `y`, `z`), image radius² `a2`,
-/// force `f`, with `q` = 1/r, r = |x_i − x_j*|. With R = (rx, ry, r3), r3 = z_i + z_j and
-/// h = z_j (see [`super::rpb`]): W_ij F_j = (A f_∥ + R_∥ (B R_∥·f_∥ + C f_z), D R_∥·f_∥ + E f_z)
-/// and W_ijᵀ F_i = (A f_∥ + R_∥ (B R_∥·f_∥ + D f_z), C R_∥·f_∥ + E f_z).
-#[allow(clippy::too_many_arguments)]
+/// The coefficients (A, B, C, D, E) of 8πμ W_ij for spheres i, j of image radii² `ai2`, `aj2`
+/// with R = x_i − x_j*, r3 = z_i + z_j (heights above the wall), h = z_j and `q` = 1/|R| (see
+/// [`super::rpb`]): 8πμ W_ij = [[A + B Rx², B Rx Ry, C Rx], [B Ry Rx, A + B Ry², C Ry],
+/// [D Rx, D Ry, E]].
 #[inline(always)]
-fn pair_terms(
-    p: &Row,
-    x: f64,
-    y: f64,
-    z: f64,
-    a2: f64,
-    f: [f64; 3],
+pub(crate) fn image_coefficients(
+    r3: f64,
+    h: f64,
+    ai2: f64,
+    aj2: f64,
     q: f64,
-) -> ([f64; 3], [f64; 3]) {
-    let (rx, ry) = (p.x - x, p.y - y);
-    let r3 = p.z + z;
-    let h = z;
-    let (ai2, aj2) = (p.a2, a2);
+) -> (f64, f64, f64, f64, f64) {
     let q2 = q * q;
     let aa = ai2 * aj2;
     let dh = ai2 - aj2;
@@ -151,6 +144,26 @@ fn pair_terms(
     let c_ = q3 * q2.mul_add(q2.mul_add(q2.mul_add(c3, c2), c1), c0);
     let d_ = q3 * q2.mul_add(q2.mul_add(q2.mul_add(-c3, -c2), d1), c0);
     let e_ = q * q2.mul_add(q2.mul_add(q2.mul_add(q2.mul_add(e4, e3), e2), e1), -1.0);
+    (a_, b_, c_, d_, e_)
+}
+
+/// 8πμ (W_ij F_j, W_ji F_i) for row `p` = i and partner j at (`x`, `y`, `z`), image radius² `a2`,
+/// force `f`, with `q` = 1/r, r = |x_i − x_j*|: W_ij F_j = (A f_∥ + R_∥ (B R_∥·f_∥ + C f_z),
+/// D R_∥·f_∥ + E f_z) and W_ijᵀ F_i = (A f_∥ + R_∥ (B R_∥·f_∥ + D f_z), C R_∥·f_∥ + E f_z)
+/// ([`image_coefficients`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn pair_terms(
+    p: &Row,
+    x: f64,
+    y: f64,
+    z: f64,
+    a2: f64,
+    f: [f64; 3],
+    q: f64,
+) -> ([f64; 3], [f64; 3]) {
+    let (rx, ry) = (p.x - x, p.y - y);
+    let (a_, b_, c_, d_, e_) = image_coefficients(p.z + z, z, p.a2, a2, q);
     // W_ij F_j.
     let rfj = rx.mul_add(f[0], ry * f[1]);
     let gj = b_.mul_add(rfj, c_ * f[2]);

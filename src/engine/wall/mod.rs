@@ -11,5 +11,6 @@ mod operator;
 mod plane;
 pub mod rpb;
 
+pub(crate) use lanes::image_coefficients;
 pub use operator::WallMobility;
 pub use plane::{Wall, DEFAULT_WALL_RANGE, DEFAULT_WALL_STIFFNESS};

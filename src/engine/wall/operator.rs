@@ -114,16 +114,10 @@ impl WallMobility {
         }
     }
 
-    /// Position `x` relative to the wall, lifted to height `a` if below it, and its damping
-    /// factor min(1, h/a).
+    /// [`Wall::lift`].
     #[inline]
     fn lift(&self, x: &Vector3<f64>, a: f64) -> (Vector3<f64>, f64) {
-        let h = x.z - self.wall.z;
-        if h >= a {
-            (Vector3::new(x.x, x.y, h), 1.0)
-        } else {
-            (Vector3::new(x.x, x.y, a), h / a)
-        }
+        self.wall.lift(x, a)
     }
 
     /// M_αβ of spheres at `xa`, `xb` (relative to the wall, lifted), undamped.

@@ -39,6 +39,19 @@ pub struct Wall {
 }
 
 impl Wall {
+    /// Position `x` relative to the wall, lifted to height `a` if below it, and its damping
+    /// factor min(1, h/a): how the mobility treats a sphere of radius `a` that does not clear
+    /// the wall ([`super::WallMobility`]).
+    #[inline]
+    pub fn lift(&self, x: &Vector3<f64>, a: f64) -> (Vector3<f64>, f64) {
+        let h = x.z - self.z;
+        if h >= a {
+            (Vector3::new(x.x, x.y, h), 1.0)
+        } else {
+            (Vector3::new(x.x, x.y, a), h / a)
+        }
+    }
+
     /// A wall at height `z` with the default repulsion and the thermal drift on.
     pub fn at(z: f64) -> Result<Self> {
         Wall {
