@@ -161,12 +161,16 @@ fn wave_pass_body(l: &Lanes, w: &Wave, acc: &mut [Vec<f64>; 3], re: &mut [f64], 
         }
     }
     let q6 = w.k2 / 6.0;
+    // Re[e^{ik·x_i}(p C − (k²/6) D)] after the projection = r α − m β with α = p Re C' − (k²/6)
+    // Re D' and β = p Im C' − (k²/6) Im D' (p = 1 − a_i²k²/6): four fused operations a component.
+    let d6 = [0, 1, 2].map(|q| [q6 * pc[q][2], q6 * pc[q][3]]);
     for i in 0..count {
         let p = 1.0 - l.a2[i] * q6;
         let (r, m) = (re[i], im[i]);
         for q in 0..3 {
-            // Re[e^{ik·x_i}(p C − (k²/6) D)] after the projection.
-            acc[q][i] += p * (r * pc[q][0] - m * pc[q][1]) - q6 * (r * pc[q][2] - m * pc[q][3]);
+            let alpha = p.mul_add(pc[q][0], -d6[q][0]);
+            let beta = p.mul_add(pc[q][1], -d6[q][1]);
+            acc[q][i] = (-m).mul_add(beta, r.mul_add(alpha, acc[q][i]));
         }
     }
 }
