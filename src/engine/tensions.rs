@@ -106,7 +106,7 @@ pub struct Tensions {
     inner_x: DVector<f64>,
     inner: CgVectors,
     products: usize,
-    /// Whether the last solve's iteration stalled and the elimination took over.
+    /// Whether the last solve ended in the elimination (on the elimination's route, always).
     eliminated: bool,
 }
 

@@ -275,7 +275,7 @@ const PROLOGUES: &[&str] = &[
 
 /// Every script has a box scene `b`, a recorder `r`, a field `f` and a continuum `c` of `b`
 /// besides its `s`. `b`'s sums are set to 1e-4: a fuzz needs no accuracy, and at the default
-/// tolerance the box's waves took a quarter of the fuzz's time (`b.ewald_tol = V` draws `()`,
+/// tolerance the box's waves take a quarter of the fuzz's time (`b.ewald_tol = V` draws `()`,
 /// which follows the integrator again, among its values).
 const COMMON: &str = "let b = scene();\nb.box = [120e-6, 120e-6, 120e-6];\nb.ewald_tol = 1e-4;\nb.add(dumbbell(#{ center: [-30e-6, 0, 0] }));\nb.add(dumbbell(#{ phase: 1.0 }));\nlet d = dumbbell();\nlet r = s.record([R_H(0)], 1);\nlet f = s.field(\"density\", #{ grid: [8, 8, 8] });\nlet c = continuum(b, #{ grid: 4, orientations: 2 });\n";
 
