@@ -44,6 +44,8 @@ pub(super) enum Fill<'a> {
 }
 
 impl<'a> Fill<'a> {
+    /// A box's minimum images where there is a box, else the wall where there is one, else open
+    /// space.
     pub(super) fn of(periodic: Option<&'a PeriodicBox>, wall: Option<&'a Wall>) -> Self {
         match (periodic, wall) {
             (Some(b), _) => Fill::MinimumImages(b),
