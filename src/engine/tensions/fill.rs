@@ -70,10 +70,9 @@ struct KLanes {
     d2: Vec<f64>,
     /// 1/(8πμ).
     c8: f64,
-    /// 1/3 for RPY (its a² term), 0 for Oseen.
+    /// 1/3 for RPY (its a² term), 0 for Oseen; above a wall 3 × it scales the image radii (RPY's
+    /// are the radii, Oseen's image is a point force's).
     finite: f64,
-    /// Whether the image radii are the radii (RPY; Oseen's image is a point force's).
-    images_sized: bool,
     /// The box's sides and their inverses for minimum images (zeros elsewhere).
     l: [f64; 3],
     inv_l: [f64; 3],
@@ -110,7 +109,7 @@ fn k_term<const WALL: bool>(
     let mut value = (o + f) * nn + (o - 3.0 * f) * nsr * ntr * inv_d2;
     if WALL {
         // R = x_a − x_b*: the in-plane separation, and the heights' sum.
-        let sized = if l.images_sized { 1.0 } else { 0.0 };
+        let sized = 3.0 * l.finite;
         let r3 = a[2] + b[2];
         let q = 1.0 / (r[0] * r[0] + r[1] * r[1] + r3 * r3).sqrt();
         let (ca, cb, cc, cd, ce) = image_coefficients(r3, b[2], sized * qa, sized * qb, q);
@@ -195,31 +194,37 @@ pub(super) fn fill_pairs(spheres: &Spheres, n: &[Vector3<f64>], fill: Fill, k: &
     let (mu, mobility) = (spheres.mu, spheres.mobility);
     let (pos, radii) = (&spheres.pos, &spheres.radii);
     // Each sphere as the fill reads it: lifted above a wall, with its damping factor.
-    let placed = |i: usize| match fill {
-        Fill::Wall(w) => w.lift(&pos[i], radii[i]),
-        _ => (pos[i], 1.0),
-    };
+    let placed: Vec<(Vector3<f64>, f64)> = pos
+        .iter()
+        .zip(radii)
+        .map(|(x, &a)| match fill {
+            Fill::Wall(w) => w.lift(x, a),
+            _ => (*x, 1.0),
+        })
+        .collect();
     let lane = |f: &dyn Fn(usize) -> f64| (0..count).map(f).collect::<Vec<f64>>();
     let lanes = KLanes {
-        p1: [0, 1, 2].map(|c| lane(&|s| placed(2 * s).0[c])),
-        p2: [0, 1, 2].map(|c| lane(&|s| placed(2 * s + 1).0[c])),
+        p1: [0, 1, 2].map(|c| lane(&|s| placed[2 * s].0[c])),
+        p2: [0, 1, 2].map(|c| lane(&|s| placed[2 * s + 1].0[c])),
         n: [0, 1, 2].map(|c| lane(&|s| n[s][c])),
         a1: lane(&|s| radii[2 * s]),
         a2: lane(&|s| radii[2 * s + 1]),
         q1: lane(&|s| radii[2 * s] * radii[2 * s]),
         q2: lane(&|s| radii[2 * s + 1] * radii[2 * s + 1]),
-        d1: lane(&|s| placed(2 * s).1),
-        d2: lane(&|s| placed(2 * s + 1).1),
+        d1: lane(&|s| placed[2 * s].1),
+        d2: lane(&|s| placed[2 * s + 1].1),
         c8: 1.0 / (8.0 * std::f64::consts::PI * mu),
         finite: if mobility == Mobility::Rpy {
             1.0 / 3.0
         } else {
             0.0
         },
-        images_sized: mobility == Mobility::Rpy,
         l,
         inv_l,
     };
+    // An entry exactly: open space's pair coefficients contracted at once (at the box's minimum
+    // images for its preconditioner; the box's own blocks are whole Ewald sums), and above a wall
+    // the wall mobility's own blocks.
     let exact = |sg: usize, tau: usize| {
         if let Fill::Wall(_) = fill {
             return k_entry(spheres, n, sg, tau);
