@@ -215,6 +215,13 @@ fn messages_name_the_fix() {
     case("print(sci(3));", "3.0000e0", 0);
     case("rosw(0);", "rosw(rtol): rtol", 1);
     case("import \"paperx\" as p;", "did you mean \"paper\"?", 1);
+    // A built-in module used by its name without an import: the import to write, not a
+    // suggestion of the very name that was given.
+    case(
+        "let s = paper::mirror(10.0, true, true);",
+        "the module \"paper\" is built in but not imported here: write import \"paper\" as paper;",
+        1,
+    );
     case(
         "import \"paper\" as p;\np::mirorr(10.0, true, true);",
         "did you mean p::mirror?",

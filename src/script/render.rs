@@ -286,8 +286,15 @@ fn operator_not_found(op: &str, args: &[String]) -> String {
     format!("the operator {op} cannot be applied to {operands}{fix}")
 }
 
+/// Rhai's "module not found": an `import` of a name that is neither built in nor a file, or a
+/// `name::` path to a module that was not imported (built-in modules too must be imported).
 fn module_not_found(m: &str) -> String {
     let names: Vec<&str> = super::stdlib::MODULES.iter().map(|(n, _)| *n).collect();
+    if names.contains(&m) {
+        return format!(
+            "the module \"{m}\" is built in but not imported here: write import \"{m}\" as {m}; before using {m}::…"
+        );
+    }
     let hint = suggest(m, &names)
         .map(|s| format!("did you mean \"{s}\"? "))
         .unwrap_or_default();
