@@ -18,9 +18,13 @@ use crate::engine::simd::{block, lane_sum, vector_dispatch, InvSqrt, LANES};
 use nalgebra::Vector3;
 
 /// The spheres as structure of arrays: positions relative to the wall (lifted), the radius each
-/// has in the pair image system (squared), and the (damped) forces.
+/// has in the pair image system (squared), and the (damped) forces; once [`WallSpheres::pad`]ded,
+/// followed by `LANES − 1` forceless copies of the last sphere, so that every row's last block of
+/// partners is a full vector block (no scalar tail).
 #[derive(Debug, Clone, Default)]
 pub(super) struct WallSpheres {
+    /// Number of spheres (the padding excluded).
+    n: usize,
     x: Vec<f64>,
     y: Vec<f64>,
     /// Heights above the wall.
@@ -35,6 +39,7 @@ pub(super) struct WallSpheres {
 impl WallSpheres {
     /// Empty the arrays (keeping their storage).
     pub(super) fn clear(&mut self) {
+        self.n = 0;
         for v in [
             &mut self.x,
             &mut self.y,
@@ -48,8 +53,11 @@ impl WallSpheres {
         }
     }
 
-    /// Append a sphere at `x` (relative to the wall) of image radius `a` under force `f`.
+    /// Append a sphere at `x` (relative to the wall) of image radius `a` under force `f`. The
+    /// arrays must be [`pad`](WallSpheres::pad)ded again before [`wall_rows`] reads them.
     pub(super) fn push(&mut self, x: &Vector3<f64>, a: f64, f: &Vector3<f64>) {
+        self.truncate_padding();
+        self.n += 1;
         self.x.push(x.x);
         self.y.push(x.y);
         self.z.push(x.z);
@@ -61,7 +69,49 @@ impl WallSpheres {
 
     /// Number of spheres.
     pub(super) fn len(&self) -> usize {
-        self.x.len()
+        self.n
+    }
+
+    /// Whether the padding is in place: `LANES − 1` slots after the spheres (none if there are no
+    /// spheres).
+    fn padded(&self) -> bool {
+        self.n == 0 || self.x.len() == self.n + LANES - 1
+    }
+
+    /// Drop the padding, if any.
+    fn truncate_padding(&mut self) {
+        let n = self.n;
+        for v in [
+            &mut self.x,
+            &mut self.y,
+            &mut self.z,
+            &mut self.a2,
+            &mut self.fx,
+            &mut self.fy,
+            &mut self.fz,
+        ] {
+            v.truncate(n);
+        }
+    }
+
+    /// Append `LANES − 1` copies of the last sphere with no force and image radius 0: every
+    /// coefficient of a pair with such a copy is finite (its image lies below the wall, at a
+    /// distance of a real pair's), so its term on a row is exactly zero, and the terms it
+    /// receives land in slots past the spheres, which no caller reads.
+    pub(super) fn pad(&mut self) {
+        self.truncate_padding();
+        let Some(last) = self.n.checked_sub(1) else {
+            return;
+        };
+        for _ in 1..LANES {
+            self.x.push(self.x[last]);
+            self.y.push(self.y[last]);
+            self.z.push(self.z[last]);
+            self.a2.push(0.0);
+            self.fx.push(0.0);
+            self.fy.push(0.0);
+            self.fz.push(0.0);
+        }
     }
 }
 
@@ -74,12 +124,13 @@ pub(super) struct WallVelocities {
 }
 
 impl WallVelocities {
-    /// `n` zero velocities.
-    pub(super) fn zeros(n: usize) -> Self {
-        WallVelocities {
-            x: vec![0.0; n],
-            y: vec![0.0; n],
-            z: vec![0.0; n],
+    /// Zero these velocities, sized for the spheres `s` and their padding (the spheres' slots
+    /// are the first `s.len()`), keeping the storage.
+    pub(super) fn reset(&mut self, s: &WallSpheres) {
+        let n = s.x.len();
+        for v in [&mut self.x, &mut self.y, &mut self.z] {
+            v.clear();
+            v.resize(n, 0.0);
         }
     }
 }
@@ -185,9 +236,14 @@ fn pair_terms(
 }
 
 /// The pair terms of rows `first..last` against their partners j > i, added to `u` (all spheres'
-/// slots) in units of 1/(8πμ); 1/r is `U`'s.
+/// slots and the padding's, [`WallVelocities::reset`]) in units of 1/(8πμ); 1/r is `U`'s. The
+/// partners run in whole vector blocks, the last one into the padding.
 #[inline(always)]
 fn rows_impl<U: InvSqrt>(s: &WallSpheres, first: usize, last: usize, u: &mut WallVelocities) {
+    assert!(
+        s.padded() && u.x.len() == s.x.len(),
+        "the wall's pair lanes need padded spheres and velocities"
+    );
     let n = s.len();
     for i in first..last {
         let p = Row {
@@ -205,7 +261,7 @@ fn rows_impl<U: InvSqrt>(s: &WallSpheres, first: usize, last: usize, u: &mut Wal
         let mut ay = [0.0; LANES];
         let mut az = [0.0; LANES];
         let start = i + 1;
-        let blocks = (n - start) / LANES;
+        let blocks = (n - start).div_ceil(LANES);
         for b in 0..blocks {
             let o = start + b * LANES;
             let l8 = o..o + LANES;
@@ -233,17 +289,6 @@ fn rows_impl<U: InvSqrt>(s: &WallSpheres, first: usize, last: usize, u: &mut Wal
                 vz[l] += tj[2];
             }
             (*ux, *uy, *uz) = (vx, vy, vz);
-        }
-        for j in start + blocks * LANES..n {
-            let q = 1.0 / r2(s.x[j], s.y[j], s.z[j]).sqrt();
-            let f = [s.fx[j], s.fy[j], s.fz[j]];
-            let (ti, tj) = pair_terms(&p, s.x[j], s.y[j], s.z[j], s.a2[j], f, q);
-            ax[0] += ti[0];
-            ay[0] += ti[1];
-            az[0] += ti[2];
-            u.x[j] += tj[0];
-            u.y[j] += tj[1];
-            u.z[j] += tj[2];
         }
         u.x[i] += lane_sum(&ax);
         u.y[i] += lane_sum(&ay);
@@ -305,6 +350,7 @@ mod tests {
                     radii.push(a);
                     forces.push(f);
                 }
+                s.pad();
                 let scale = 8.0 * PI * MU;
                 let expected: Vec<Vector3<f64>> = (0..n)
                     .map(|i| {
@@ -320,7 +366,8 @@ mod tests {
                     .collect();
                 let largest = expected.iter().map(|v| v.amax()).fold(0.0, f64::max);
                 for split in [n, n / 2, 1] {
-                    let mut u = WallVelocities::zeros(n);
+                    let mut u = WallVelocities::default();
+                    u.reset(&s);
                     let mut first = 0;
                     while first < n {
                         let last = (first + split.max(1)).min(n);

@@ -48,26 +48,26 @@ fn row_chunks(n: usize, chunks: usize) -> Vec<usize> {
     starts
 }
 
-/// The wall's pair terms of the spheres `soa`, in units of 1/(8πμ): one buffer per chunk of rows
-/// ([`chunk_count`]), the chunks on rayon's threads where there are several; the caller adds the
-/// buffers in chunk order, so the result does not depend on the threads or how the work was
-/// stolen.
-fn wall_pair_terms(soa: &WallSpheres) -> Vec<WallVelocities> {
+/// The wall's pair terms of the spheres `soa`, in units of 1/(8πμ), into `parts`: one buffer per
+/// chunk of rows ([`chunk_count`]; the buffers' storage is kept from call to call), the chunks on
+/// rayon's threads where there are several; the caller adds the buffers in chunk order, so the
+/// result does not depend on the threads or how the work was stolen.
+fn wall_pair_terms(soa: &WallSpheres, parts: &mut Vec<WallVelocities>) {
     let n = soa.len();
     let chunks = chunk_count(n);
+    parts.resize_with(chunks, WallVelocities::default);
     if chunks == 1 {
-        let mut u = WallVelocities::zeros(n);
-        wall_rows(soa, 0, n, &mut u);
-        return vec![u];
+        parts[0].reset(soa);
+        wall_rows(soa, 0, n, &mut parts[0]);
+        return;
     }
     row_chunks(n, chunks)
         .par_windows(2)
-        .map(|w| {
-            let mut u = WallVelocities::zeros(n);
-            wall_rows(soa, w[0], w[1], &mut u);
-            u
-        })
-        .collect()
+        .zip(parts.par_iter_mut())
+        .for_each(|(w, u)| {
+            u.reset(soa);
+            wall_rows(soa, w[0], w[1], u);
+        });
 }
 
 /// Spheres in a fluid of viscosity `mu` above the no-slip plane of `wall`.
@@ -85,6 +85,8 @@ pub struct WallMobility {
     damped: Vec<Vector3<f64>>,
     /// Scratch: the lifted spheres and damped forces as the pair lanes read them.
     soa: WallSpheres,
+    /// Scratch: the wall's pair terms, one buffer per chunk of rows.
+    parts: Vec<WallVelocities>,
 }
 
 impl WallMobility {
@@ -102,6 +104,7 @@ impl WallMobility {
             damping: Vec::new(),
             damped: Vec::new(),
             soa: WallSpheres::default(),
+            parts: Vec::new(),
         }
     }
 
@@ -249,18 +252,20 @@ impl MobilityOperator for WallMobility {
         for ((x, &a), f) in self.lifted.iter().zip(radii).zip(&self.damped) {
             self.soa.push(x, self.image_radius(a), f);
         }
+        self.soa.pad();
         let (open, lifted, damped, soa) = (&mut self.open, &self.lifted, &self.damped, &self.soa);
+        let parts = &mut self.parts;
         let mut open_pairs = || open.interaction_velocities(lifted, radii, damped, out);
-        let parts = if n >= PARALLEL_IMAGE_SPHERES {
-            rayon::join(open_pairs, || wall_pair_terms(soa)).1
+        if n >= PARALLEL_IMAGE_SPHERES {
+            rayon::join(open_pairs, || wall_pair_terms(soa, parts));
         } else {
             open_pairs();
-            wall_pair_terms(soa)
-        };
+            wall_pair_terms(soa, parts);
+        }
         let scale = 1.0 / (8.0 * PI * self.mu);
         for (i, o) in out.iter_mut().enumerate() {
             let mut w = Vector3::zeros();
-            for part in &parts {
+            for part in &self.parts {
                 w += Vector3::new(part.x[i], part.y[i], part.z[i]);
             }
             let c = rpb::self_correction(self.mu, self.lifted[i].z, radii[i]);
