@@ -7,7 +7,7 @@
 //! cube. The times are medians of right-hand sides repeated until each series has run ~0.3 s or
 //! 1,000 times (at least 3), the system built once (as a run builds it once) and the time
 //! advanced by a fortieth of a period between them (as a run's stages advance; the rigid model's
-//! iteration starts from the last tensions). The box's sums keep the tolerance the scene's
+//! iteration starts from the earlier tensions). The box's sums keep the tolerance the scene's
 //! default integrator gives them (`Scene::ewald_tol`) unless another is given; the table says
 //! which. Above the wall the divergence ∇·M, which a thermal run adds as the drift kT ∇·M once a
 //! right-hand side, is timed at the same state.

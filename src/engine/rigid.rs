@@ -37,7 +37,7 @@ pub struct RigidSystem {
     swimmers: Vec<Dumbbell>,
     base: Vec<Vector3<f64>>,
     spheres: Spheres,
-    /// The constraint solve, its scratch and last tensions.
+    /// The constraint solve, its scratch and earlier tensions.
     tensions: Tensions,
     /// The stroke rates less the body forces' part, then the tensions.
     rate: DVector<f64>,
