@@ -88,7 +88,7 @@ fn systems(model: Model) -> (Box<dyn OdeSystem>, Vec<f64>) {
             base,
             1e-3,
             Mobility::Rpy,
-            false,
+            Default::default(),
         )),
         Model::Averaged => Box::new(AveragedSystem::new(
             s.swimmers(),

@@ -4,7 +4,7 @@
 //! script syntax.
 
 use swimlab::engine::error::Setting;
-use swimlab::engine::{Dumbbell, EngineError, Model, Scene, Steric};
+use swimlab::engine::{Dumbbell, EngineError, Model, Scene, Simulation};
 use swimlab::script::engine_message;
 
 fn fixes(e: &EngineError) -> Vec<Setting> {
@@ -48,11 +48,11 @@ fn engine_errors_name_typed_fixes_that_scripts_show_as_script_lines() {
     );
 
     s.set_model(Model::Rigid);
-    s.set_steric(Some(Steric::new(1e-7, 1e-3).unwrap()));
-    let e = s.rates(0).unwrap_err();
-    assert!(fixes(&e).contains(&Setting::NoSteric));
-    assert!(engine_message(&e).contains("s.steric = ()"));
-    for e in [s.rates(0).unwrap_err(), no_tension] {
+    s.set_temperature(300.0).unwrap();
+    let e = Simulation::new(s.clone()).run_periods(0.01).unwrap_err();
+    assert!(fixes(&e).contains(&Setting::NoNoise));
+    assert!(engine_message(&e).contains("s.temperature = 0"));
+    for e in [e, no_tension] {
         assert!(!e.to_string().contains("s."), "engine words only: {e}");
     }
 }

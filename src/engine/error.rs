@@ -15,8 +15,6 @@ pub enum Setting {
     DefaultIntegrator,
     /// A fixed step below ~2.8 over the scene's stiff rate.
     StableStep,
-    /// Steric repulsion switched off.
-    NoSteric,
     /// Steric repulsion between swimmers switched on.
     Steric,
     /// Overlapping spheres of different swimmers allowed.
@@ -53,7 +51,6 @@ impl std::fmt::Display for Setting {
             }
             Setting::DefaultIntegrator => f.write_str("the model's default integrator"),
             Setting::StableStep => f.write_str("a step below ~2.8 / (the scene's stiff rate)"),
-            Setting::NoSteric => f.write_str("no steric repulsion"),
             Setting::Steric => f.write_str(
                 "steric repulsion between swimmers (e.g. range 1e-7 m, stiffness 1e-3 N/m)",
             ),

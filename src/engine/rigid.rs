@@ -6,8 +6,8 @@
 //! sphere is linear in the tensions, and the constraint d(|X₂ − X₁|)/dt = L̇ for every dumbbell is an
 //! S×S linear system A T = L̇ − N·(v^b₂ − v^b₁) with
 //! A_στ = N_σ · [(H_{2σ,1τ} − H_{1σ,1τ}) − (H_{2σ,2τ} − H_{1σ,2τ})] N_τ,
-//! where v^b = M F^b are the sphere velocities of the body forces (a wall's repulsion, external
-//! forces; zero without them).
+//! where v^b = M F^b are the sphere velocities of the body forces (steric repulsion between
+//! swimmers, a wall's repulsion, external forces; zero without them).
 //! Then, as in the spring model, dR_H/dt = (a1 u₁ + a2 u₂)/(a1+a2) (the drag parts cancel exactly)
 //! and dN/dt = (I − NNᵀ)(u₂ − u₁)/L, u the interaction velocities. Nothing is stiff any more: the
 //! step is set by the stroke, not by the spring.
@@ -50,22 +50,18 @@ pub struct RigidSystem {
 }
 
 impl RigidSystem {
-    /// A system for these swimmers, base positions, viscosity and mobility.
-    ///
-    /// `allow_overlap` lets spheres of different swimmers overlap (see [`Contacts`]); the steric
-    /// repulsion has no place here, since the constraint solve takes dumbbell tensions only.
+    /// A system for these swimmers, base positions, viscosity and mobility, its spheres in
+    /// contact as `contacts` says: overlaps allowed or not, and the steric repulsion between
+    /// swimmers, a body force like a wall's repulsion (its velocities leave the tensions less of
+    /// each stroke's rate to make up).
     pub fn new(
         swimmers: &[Dumbbell],
         base: &[Vector3<f64>],
         mu: f64,
         mobility: Mobility,
-        allow_overlap: bool,
+        contacts: Contacts,
     ) -> Self {
         let s = swimmers.len();
-        let contacts = Contacts {
-            allow_overlap,
-            steric: None,
-        };
         RigidSystem {
             swimmers: swimmers.to_vec(),
             base: base.to_vec(),
@@ -123,8 +119,8 @@ impl RigidSystem {
         for (sg, d) in self.swimmers.iter().enumerate() {
             self.rate[sg] = d.lambda * d.omega * (d.omega * t + d.phase).cos();
         }
-        // Body forces (a wall's repulsion, external forces) move the spheres too: the tensions
-        // make up what their velocities leave of L̇.
+        // Body forces (steric repulsion, a wall's repulsion, external forces) move the spheres
+        // too: the tensions make up what their velocities leave of L̇.
         if self.spheres.body_velocities(&mut self.body) {
             for (sg, ns) in self.n.iter().enumerate() {
                 self.rate[sg] -= ns.dot(&(self.body[2 * sg + 1] - self.body[2 * sg]));
@@ -213,16 +209,9 @@ impl OdeSystem for RigidSystem {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct RigidStrokes;
 
-/// The rigid-stroke system of scene `s` (steric repulsion aside, which [`RigidStrokes`] refuses):
-/// the one every run and the tensions use.
+/// The rigid-stroke system of scene `s`: the one every run and the tensions use.
 fn rigid_system(s: &dyn SceneView) -> error::Result<RigidSystem> {
-    let mut sys = RigidSystem::new(
-        s.swimmers(),
-        s.base(),
-        s.mu(),
-        s.mobility(),
-        s.contacts().allow_overlap,
-    );
+    let mut sys = RigidSystem::new(s.swimmers(), s.base(), s.mu(), s.mobility(), s.contacts());
     // Products by the scene's Ewald method; blocks (a few swimmers' elimination) are
     // Beenakker's sums whatever it is.
     sys.set_boundary(*s.boundary(), s.mobility_operator_by(s.ewald_method())?);
@@ -237,12 +226,6 @@ impl SwimmerModel for RigidStrokes {
     }
 
     fn system(&self, s: &dyn SceneView) -> error::Result<Box<dyn OdeSystem>> {
-        if s.contacts().steric.is_some() {
-            return Err(unsupported(
-                "steric repulsion is not available in the rigid-stroke model (its constraint solve takes dumbbell tensions only)",
-                &[Setting::Model("micro"), Setting::Model("averaged"), Setting::NoSteric],
-            ));
-        }
         Ok(Box::new(rigid_system(s)?))
     }
 

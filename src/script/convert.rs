@@ -40,7 +40,6 @@ pub fn setting_in_script(s: &Setting) -> String {
         Setting::FixedStep => "s.integrator = rk4(dt)".into(),
         Setting::DefaultIntegrator => "s.integrator = \"default\"".into(),
         Setting::StableStep => "a step dt below ~2.8 / s.stiff_rate".into(),
-        Setting::NoSteric => "s.steric = ()".into(),
         Setting::Steric => "s.steric = #{ range: 1e-7, stiffness: 1e-3 }".into(),
         Setting::AllowOverlaps => "s.overlaps = \"allow\"".into(),
         Setting::NoCutoff => "s.cutoff = ()".into(),
