@@ -35,8 +35,10 @@
 //! - **Closing step.** A step that ends the run is first tried by Heun's method with Euler's
 //!   embedded estimate: one new slope instead of six. A slow motion over a short run (a pair over
 //!   100 periods changes its slope by far less than the tolerance) takes it; a rejection costs
-//!   that one slope, Dormand-Prince takes the step as before, and Heun is not tried again until
-//!   the next start (a motion too fast for it once is rarely slow enough later in the run).
+//!   that one slope, Dormand-Prince takes the step as before where it would save at least as
+//!   many periods as it samples (else the rest is integrated directly: a rejection would waste
+//!   all its samples), and Heun is not tried again until the next start (a motion too fast for
+//!   it once is rarely slow enough later in the run).
 //! - **Direct runs.** The start transient (whenever the state is not the one this stepper left:
 //!   a fresh run, a changed phase, a loaded scene), a remainder of less than [`MIN_MACRO`] periods
 //!   and the fraction of a period before `t_end` are integrated by the inner (microscopic)

@@ -306,8 +306,18 @@ impl Stepper for Stroboscopic {
                     _ => {
                         stats.rejected += 1;
                         self.heun_refused = true;
-                        if m < paying {
-                            let why = too_short(self);
+                        // Dormand-Prince over the rest of the run would sample `paying` periods
+                        // to save the other m − paying, and a rejection would waste them all: it
+                        // is tried only where it would save at least as many as it samples.
+                        if m < 2 * paying {
+                            let why = if m < paying {
+                                too_short(self)
+                            } else {
+                                format!(
+                                    "Heun's closing step over the {m} periods left was rejected, and a Dormand-Prince step would sample {paying} of them to save at most {}",
+                                    m - paying
+                                )
+                            };
                             return self.fall_back(sys, t, y, whole, why, stats, snap);
                         }
                     }
