@@ -219,7 +219,7 @@ fn messages_name_the_fix() {
     // suggestion of the very name that was given.
     case(
         "let s = paper::mirror(10.0, true, true);",
-        "the module \"paper\" is built in but not imported here: write import \"paper\" as paper;",
+        "the module \"paper\" is built in but not imported under that name here: write import \"paper\" as paper;",
         1,
     );
     case(

@@ -116,8 +116,8 @@ impl Spheres {
     }
 
     /// The velocities the body forces alone give every sphere, M F^b, self drag included, into
-    /// `out`; `false` (nothing written) when there are none or all are zero. The rigid-stroke model's
-    /// constraints take them out of the tensions' right-hand side.
+    /// `out`; `false` (nothing written) when there are none or all are zero. The rigid-stroke
+    /// model's constraints take them out of the tensions' right-hand side.
     pub(crate) fn body_velocities(&mut self, out: &mut Vec<Vector3<f64>>) -> bool {
         self.body_forces();
         // None, or all zero (no swimmer within the steric range, none near the wall): M·0 = 0

@@ -292,7 +292,7 @@ fn module_not_found(m: &str) -> String {
     let names: Vec<&str> = super::stdlib::MODULES.iter().map(|(n, _)| *n).collect();
     if names.contains(&m) {
         return format!(
-            "the module \"{m}\" is built in but not imported here: write import \"{m}\" as {m}; before using {m}::…"
+            "the module \"{m}\" is built in but not imported under that name here: write import \"{m}\" as {m}; before using {m}::… (or use the name an import gave it)"
         );
     }
     let hint = suggest(m, &names)

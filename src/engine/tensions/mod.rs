@@ -21,8 +21,8 @@
 //! products (up to [`DENSE_MATRIX_UP_TO`] swimmers) by open space's K at the minimum images,
 //! filled as above and solved on the matrix (an inner iteration, hence the flexible β), and
 //! beyond by the diagonal. Every iteration starts from the tensions of the last solves,
-//! extrapolated in time to this one's ([`Earlier`]); where it stalls, the blocks and elimination take over. No route has an S³ term but the
-//! elimination of a few swimmers and that fallback.
+//! extrapolated in time to this one's ([`Earlier`]); where it stalls, the blocks and elimination
+//! take over. No route has an S³ term but the elimination of a few swimmers and that fallback.
 //!
 //! - `fill.rs`: K from blocks, or from the pair coefficients in vector lanes;
 //! - `lower.rs`: K's products from its part on and below the diagonal.
@@ -285,7 +285,7 @@ impl Tensions {
         }
     }
 
-    /// Conjugate gradients for K T = −rate from the last tensions, preconditioned by open
+    /// Conjugate gradients for K T = −rate from the earlier tensions, preconditioned by open
     /// space's K where it is held for the products' iteration, else by the diagonal; the tensions
     /// in `rate`. False (rate untouched) if the residual did not fall to [`TENSION_RTOL`].
     fn iterate(

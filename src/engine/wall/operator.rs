@@ -55,13 +55,16 @@ fn row_chunks(n: usize, chunks: usize) -> Vec<usize> {
 fn wall_pair_terms(soa: &WallSpheres, parts: &mut Vec<WallVelocities>) {
     let n = soa.len();
     let chunks = chunk_count(n);
-    parts.resize_with(chunks, WallVelocities::default);
     if chunks == 1 {
+        parts.resize_with(1, WallVelocities::default);
         parts[0].reset(soa);
         wall_rows(soa, 0, n, &mut parts[0]);
         return;
     }
-    row_chunks(n, chunks)
+    // One buffer per chunk the rows were cut into: none left over with an earlier product's sums.
+    let starts = row_chunks(n, chunks);
+    parts.resize_with(starts.len() - 1, WallVelocities::default);
+    starts
         .par_windows(2)
         .zip(parts.par_iter_mut())
         .for_each(|(w, u)| {

@@ -284,9 +284,24 @@ impl Stepper for Stroboscopic {
                 )
             };
             let heun_next = m == whole && !self.heun_refused;
-            if self.fixed.is_none() && m < paying && !heun_next {
-                let why = too_short(self);
-                return self.fall_back(sys, t, y, whole, why, stats, snap);
+            // Dormand-Prince over the rest of the run would sample `paying` periods to save the
+            // other m − paying, and a rejection would waste them all: once Heun's closing step
+            // was refused, it is tried only where it would save at least as many as it samples.
+            let closing = || {
+                format!(
+                    "Heun's closing step was rejected, and a Dormand-Prince step over the {m} periods left would sample {paying} of them to save at most {}",
+                    m.saturating_sub(paying)
+                )
+            };
+            if self.fixed.is_none() && !heun_next {
+                if m < paying {
+                    let why = too_short(self);
+                    return self.fall_back(sys, t, y, whole, why, stats, snap);
+                }
+                if m == whole && m < 2 * paying {
+                    let why = closing();
+                    return self.fall_back(sys, t, y, whole, why, stats, snap);
+                }
             }
             // A step that ends the run first tries Heun's method: a slow motion over a short run
             // takes it at the price of one slope, where a rejection costs that slope only, once
@@ -306,17 +321,11 @@ impl Stepper for Stroboscopic {
                     _ => {
                         stats.rejected += 1;
                         self.heun_refused = true;
-                        // Dormand-Prince over the rest of the run would sample `paying` periods
-                        // to save the other m − paying, and a rejection would waste them all: it
-                        // is tried only where it would save at least as many as it samples.
                         if m < 2 * paying {
                             let why = if m < paying {
                                 too_short(self)
                             } else {
-                                format!(
-                                    "Heun's closing step over the {m} periods left was rejected, and a Dormand-Prince step would sample {paying} of them to save at most {}",
-                                    m - paying
-                                )
+                                closing()
                             };
                             return self.fall_back(sys, t, y, whole, why, stats, snap);
                         }
