@@ -359,14 +359,9 @@ fn close_pairs_keep_the_tolerance() {
     }
 }
 
-/// A run too short for a Dormand-Prince step to save as many periods as it samples: where the
-/// closing Heun step is rejected, the rest is integrated directly instead of risking that step's
-/// samples. The pair 1.6ℓ apart at tol 1e-8 (macro steps all fail) over 32 periods: the probe's
-/// and Heun's samples (one slope each, at most 6 periods apiece: the highest degree) on top of
-/// at most the 32 direct ones, so at most 32 + 12 sample periods. Measured 43 (12 sampled, 31
-/// direct); before this rule a Dormand-Prince attempt added its slopes' samples: 74.
-#[test]
-fn a_short_run_whose_closing_step_fails_is_integrated_directly() {
+/// A symmetric pair 1.6ℓ apart, tilted, under stroboscopic averaging at tol 1e-8: its macro steps
+/// all fail.
+fn close_pair_at_tol_1e8() -> Scene {
     let mut s = Scene::new();
     for (x, dir, phase) in [
         (-0.8 * ELL, Vector3::new(1.0, 0.2, 0.0), 0.0),
@@ -384,7 +379,18 @@ fn a_short_run_whose_closing_step_fails_is_integrated_directly() {
         .unwrap();
     }
     s.set_integrator(Some(IntegratorSpec::stroboscopic(1e-8).unwrap()));
-    let mut sim = Simulation::new(s);
+    s
+}
+
+/// A run too short for a Dormand-Prince step to save as many periods as it samples: where the
+/// closing Heun step is rejected, the rest is integrated directly instead of risking that step's
+/// samples. The pair 1.6ℓ apart at tol 1e-8 (macro steps all fail) over 32 periods: the probe's
+/// and Heun's samples (one slope each, at most 6 periods apiece: the highest degree) on top of
+/// at most the 32 direct ones, so at most 32 + 12 sample periods. Measured 43 (12 sampled, 31
+/// direct); before this rule a Dormand-Prince attempt added its slopes' samples: 74.
+#[test]
+fn a_short_run_whose_closing_step_fails_is_integrated_directly() {
+    let mut sim = Simulation::new(close_pair_at_tol_1e8());
     sim.run_periods(32.0).unwrap();
     let st = sim.stats();
     assert!(st.direct_fallbacks >= 1, "{st:?}");
@@ -399,24 +405,7 @@ fn a_short_run_whose_closing_step_fails_is_integrated_directly() {
 /// 1.40×; before the rule, 2.41×.
 #[test]
 fn where_macro_steps_cannot_pay_the_run_is_about_as_costly_as_the_direct_one() {
-    let mut s = Scene::new();
-    for (x, dir, phase) in [
-        (-0.8 * ELL, Vector3::new(1.0, 0.2, 0.0), 0.0),
-        (
-            0.8 * ELL,
-            Vector3::new(-1.0, 0.3, 0.1),
-            std::f64::consts::FRAC_PI_2,
-        ),
-    ] {
-        s.add(
-            common::swimmer(0.15, false, phase),
-            Vector3::new(x, 0.0, 0.0),
-            dir,
-        )
-        .unwrap();
-    }
-    s.set_integrator(Some(IntegratorSpec::stroboscopic(1e-8).unwrap()));
-    let mut sim = Simulation::new(s);
+    let mut sim = Simulation::new(close_pair_at_tol_1e8());
     sim.run_periods(200.0).unwrap();
     let st = sim.stats();
     eprintln!("{st:?}");

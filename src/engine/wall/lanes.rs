@@ -40,17 +40,7 @@ impl WallSpheres {
     /// Empty the arrays (keeping their storage).
     pub(super) fn clear(&mut self) {
         self.n = 0;
-        for v in [
-            &mut self.x,
-            &mut self.y,
-            &mut self.z,
-            &mut self.a2,
-            &mut self.fx,
-            &mut self.fy,
-            &mut self.fz,
-        ] {
-            v.clear();
-        }
+        self.truncate_padding();
     }
 
     /// Append a sphere at `x` (relative to the wall) of image radius `a` under force `f`. The
@@ -78,7 +68,7 @@ impl WallSpheres {
         self.n == 0 || self.x.len() == self.n + LANES - 1
     }
 
-    /// Drop the padding, if any.
+    /// Drop the padding, if any (everything, once `n` is 0).
     fn truncate_padding(&mut self) {
         let n = self.n;
         for v in [
