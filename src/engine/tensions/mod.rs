@@ -24,9 +24,11 @@
 //! extrapolated in time to this one's ([`Earlier`]); where it stalls, the blocks and elimination
 //! take over. No route has an S³ term but the elimination of a few swimmers and that fallback.
 //!
+//! - `earlier.rs`: the earlier solves' tensions, extrapolated in time to an iteration's start;
 //! - `fill.rs`: K from blocks, or from the pair coefficients in vector lanes;
 //! - `lower.rs`: K's products from its part on and below the diagonal.
 
+mod earlier;
 mod fill;
 mod lower;
 
@@ -37,6 +39,7 @@ use super::periodic::PeriodicBox;
 use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
 use super::wall::Wall;
+use earlier::Earlier;
 use fill::{fill_blocks, fill_pairs, Fill};
 use lower::lower_mul_to;
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -62,79 +65,6 @@ const INNER_RTOL: f64 = 1e-10;
 /// Iterations before the elimination takes over (CG ends in S in exact arithmetic; at the
 /// densities the model holds it takes tens).
 const MAX_ITERATIONS: usize = 500;
-
-/// Solves whose tensions the next iteration's start is extrapolated from (quadratically).
-const EXTRAPOLATED_FROM: usize = 3;
-
-/// The largest weight an extrapolation may give one earlier solve: beyond it the times lie too
-/// close together for the distance asked (the start would amplify their own residuals), and
-/// fewer of them, down to the last tensions alone, are taken.
-const MAX_EXTRAPOLATION_WEIGHT: f64 = 8.0;
-
-/// The tensions of the last solves and their times, oldest first: the iteration's start is their
-/// polynomial in time at the new solve's time. The tensions follow each stroke's rate, smooth in
-/// t, so between a run's stages (a fraction of a period apart) the quadratic through three solves
-/// lies far closer to the new tensions than the last alone, and the iteration, which stops at a
-/// residual relative to the right side, needs fewer products to get there.
-#[derive(Debug, Clone, Default)]
-struct Earlier {
-    times: Vec<f64>,
-    tensions: Vec<DVector<f64>>,
-}
-
-impl Earlier {
-    /// Keep `x`, solved at `t`, dropping the oldest beyond [`EXTRAPOLATED_FROM`] (a solve at
-    /// the newest one's time replaces it).
-    fn push(&mut self, t: f64, x: &DVector<f64>) {
-        if self.times.last() == Some(&t) {
-            self.times.pop();
-            self.tensions.pop();
-        }
-        let mut v = if self.times.len() >= EXTRAPOLATED_FROM {
-            self.times.remove(0);
-            self.tensions.remove(0)
-        } else {
-            DVector::zeros(x.len())
-        };
-        v.copy_from(x);
-        self.times.push(t);
-        self.tensions.push(v);
-    }
-
-    fn clear(&mut self) {
-        self.times.clear();
-        self.tensions.clear();
-    }
-
-    /// The polynomial through the newest solves at `t` into `x`: as many of them (from
-    /// [`EXTRAPOLATED_FROM`] down to one) as keep every weight within
-    /// [`MAX_EXTRAPOLATION_WEIGHT`]. False (x untouched) if there are none.
-    fn extrapolate(&self, t: f64, x: &mut DVector<f64>) -> bool {
-        let n = self.times.len();
-        for m in (1..=n).rev() {
-            let ts = &self.times[n - m..];
-            let weights: Vec<f64> = (0..m)
-                .map(|i| {
-                    (0..m)
-                        .filter(|&j| j != i)
-                        .map(|j| (t - ts[j]) / (ts[i] - ts[j]))
-                        .product()
-                })
-                .collect();
-            if weights
-                .iter()
-                .all(|w| w.is_finite() && w.abs() <= MAX_EXTRAPOLATION_WEIGHT)
-            {
-                x.fill(0.0);
-                for (w, v) in weights.iter().zip(&self.tensions[n - m..]) {
-                    x.axpy(*w, v, 1.0);
-                }
-                return true;
-            }
-        }
-        false
-    }
-}
 
 /// How K is met.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -165,10 +95,9 @@ impl Route {
 pub struct Tensions {
     route: Route,
     k: DMatrix<f64>,
-    /// The iteration's tensions: its start (extrapolated from `earlier`, when `warm`), then its
-    /// solution.
-    last: DVector<f64>,
-    warm: bool,
+    /// The iteration's tensions: its start (extrapolated from `earlier`), then its solution.
+    x: DVector<f64>,
+    /// The last solves' tensions and times.
     earlier: Earlier,
     forces: Vec<f64>,
     velocities: Vec<f64>,
@@ -215,8 +144,7 @@ impl Tensions {
             } else {
                 DMatrix::zeros(0, 0)
             },
-            last: zeros(),
-            warm: false,
+            x: zeros(),
             earlier: Earlier::default(),
             forces: vec![0.0; 6 * swimmers],
             velocities: vec![0.0; 6 * swimmers],
@@ -275,8 +203,6 @@ impl Tensions {
         self.eliminated = !solved;
         if !solved {
             eliminate(spheres, n, &mut self.k, rate);
-            self.last.copy_from(rate);
-            self.warm = true;
         }
         if rate.iter().all(|v| v.is_finite()) {
             self.earlier.push(t, rate);
@@ -298,15 +224,12 @@ impl Tensions {
     ) -> bool {
         let b_norm = rate.norm();
         if b_norm == 0.0 {
-            self.last.fill(0.0);
-            self.warm = true;
             return true;
         }
         let Tensions {
             route,
             k,
-            last: x,
-            warm,
+            x,
             earlier,
             forces,
             velocities,
@@ -329,7 +252,7 @@ impl Tensions {
                 self_mobility(mu, d.a1) + self_mobility(mu, d.a2) - 2.0 * (ci + crr)
             };
         }
-        if !(*warm && earlier.extrapolate(t, x) && x.iter().all(|v| v.is_finite())) {
+        if !(earlier.extrapolate(t, x) && x.iter().all(|v| v.is_finite())) {
             x.zip_apply(rate, |xs, b| *xs = -b);
             x.component_div_assign(diag);
         }
@@ -389,12 +312,10 @@ impl Tensions {
             .zip_zip_apply(rate, &outer.q, |rs, b, q| *rs = -b - q);
         let max = MAX_ITERATIONS.min(swimmers.len() + 50);
         if !cg(x, outer, TENSION_RTOL * b_norm, max, apply, precondition) {
-            *warm = false;
             earlier.clear();
             return false;
         }
         rate.copy_from(x);
-        *warm = true;
         true
     }
 }
@@ -479,35 +400,6 @@ mod tests {
                 "{count} rows: error {err:e}"
             );
         }
-    }
-
-    /// The start is the polynomial through the earlier solves: exact on a quadratic in t from
-    /// three solves (to rounding, 1e-12 of its values ~1), the last tensions alone where the
-    /// times are too close for the distance asked (weights beyond the bound), a solve at the
-    /// newest time replacing it, and nothing from no solves.
-    #[test]
-    fn the_start_is_extrapolated_from_the_earlier_solves() {
-        let f = |t: f64| DVector::from_vec(vec![1.0 + 2.0 * t - 3.0 * t * t, -0.5 * t * t]);
-        let mut e = Earlier::default();
-        let mut x = DVector::zeros(2);
-        assert!(!e.extrapolate(0.3, &mut x));
-        for t in [0.0, 0.1, 0.2] {
-            e.push(t, &f(t));
-        }
-        for t in [0.25, 0.35, 0.15] {
-            assert!(e.extrapolate(t, &mut x));
-            assert!((&x - f(t)).amax() < 1e-12, "t {t}: {x} vs {}", f(t));
-        }
-        // Far beyond the solves' span the quadratic's weights exceed the bound, and the linear
-        // one's too: the last tensions.
-        assert!(e.extrapolate(5.0, &mut x));
-        assert_eq!(x, f(0.2));
-        // A solve at the newest time replaces it; the oldest drops out beyond three.
-        e.push(0.2, &f(0.2));
-        e.push(0.3, &f(0.3));
-        assert_eq!(e.times, vec![0.1, 0.2, 0.3]);
-        assert!(e.extrapolate(0.4, &mut x));
-        assert!((&x - f(0.4)).amax() < 1e-12);
     }
 
     #[test]

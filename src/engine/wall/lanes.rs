@@ -18,9 +18,9 @@ use crate::engine::simd::{block, lane_sum, vector_dispatch, InvSqrt, LANES};
 use nalgebra::Vector3;
 
 /// The spheres as structure of arrays: positions relative to the wall (lifted), the radius each
-/// has in the pair image system (squared), and the (damped) forces; once [`WallSpheres::pad`]ded,
-/// followed by `LANES − 1` forceless copies of the last sphere, so that every row's last block of
-/// partners is a full vector block (no scalar tail).
+/// has in the pair image system (squared), and the (damped) forces, followed by `LANES − 1`
+/// forceless copies of the last sphere ([`WallSpheres::fill`] lays them), so that every row's
+/// last block of partners is a full vector block (no scalar tail).
 #[derive(Debug, Clone, Default)]
 pub(super) struct WallSpheres {
     /// Number of spheres (the padding excluded).
@@ -37,40 +37,13 @@ pub(super) struct WallSpheres {
 }
 
 impl WallSpheres {
-    /// Empty the arrays (keeping their storage).
-    pub(super) fn clear(&mut self) {
+    /// Hold these spheres: each at `x` (relative to the wall), of image radius `a`, under force
+    /// `f`; then the padding. The storage is kept from one filling to the next.
+    pub(super) fn fill<'a>(
+        &mut self,
+        spheres: impl IntoIterator<Item = ((&'a Vector3<f64>, f64), &'a Vector3<f64>)>,
+    ) {
         self.n = 0;
-        self.truncate_padding();
-    }
-
-    /// Append a sphere at `x` (relative to the wall) of image radius `a` under force `f`. The
-    /// arrays must be [`pad`](WallSpheres::pad)ded again before [`wall_rows`] reads them.
-    pub(super) fn push(&mut self, x: &Vector3<f64>, a: f64, f: &Vector3<f64>) {
-        self.truncate_padding();
-        self.n += 1;
-        self.x.push(x.x);
-        self.y.push(x.y);
-        self.z.push(x.z);
-        self.a2.push(a * a);
-        self.fx.push(f.x);
-        self.fy.push(f.y);
-        self.fz.push(f.z);
-    }
-
-    /// Number of spheres.
-    pub(super) fn len(&self) -> usize {
-        self.n
-    }
-
-    /// Whether the padding is in place: `LANES − 1` slots after the spheres (none if there are no
-    /// spheres).
-    fn padded(&self) -> bool {
-        self.n == 0 || self.x.len() == self.n + LANES - 1
-    }
-
-    /// Drop the padding, if any (everything, once `n` is 0).
-    fn truncate_padding(&mut self) {
-        let n = self.n;
         for v in [
             &mut self.x,
             &mut self.y,
@@ -80,16 +53,31 @@ impl WallSpheres {
             &mut self.fy,
             &mut self.fz,
         ] {
-            v.truncate(n);
+            v.clear();
         }
+        for ((x, a), f) in spheres {
+            self.n += 1;
+            self.x.push(x.x);
+            self.y.push(x.y);
+            self.z.push(x.z);
+            self.a2.push(a * a);
+            self.fx.push(f.x);
+            self.fy.push(f.y);
+            self.fz.push(f.z);
+        }
+        self.pad();
+    }
+
+    /// Number of spheres.
+    pub(super) fn len(&self) -> usize {
+        self.n
     }
 
     /// Append `LANES − 1` copies of the last sphere with no force and image radius 0: every
     /// coefficient of a pair with such a copy is finite (its image lies below the wall, at a
     /// distance of a real pair's), so its term on a row is exactly zero, and the terms it
     /// receives land in slots past the spheres, which no caller reads.
-    pub(super) fn pad(&mut self) {
-        self.truncate_padding();
+    fn pad(&mut self) {
         let Some(last) = self.n.checked_sub(1) else {
             return;
         };
@@ -231,8 +219,8 @@ fn pair_terms(
 #[inline(always)]
 fn rows_impl<U: InvSqrt>(s: &WallSpheres, first: usize, last: usize, u: &mut WallVelocities) {
     assert!(
-        s.padded() && u.x.len() == s.x.len(),
-        "the wall's pair lanes need padded spheres and velocities"
+        u.x.len() == s.x.len(),
+        "the wall's pair lanes need velocities sized by WallVelocities::reset"
     );
     let n = s.len();
     for i in first..last {
@@ -306,7 +294,7 @@ mod tests {
 
     /// The lanes against the scalar blocks summed pair by pair, Σ_{j≠i} W_ij F_j, for sizes below,
     /// at and above multiples of the lane width (a last block reaching into the padding, full
-    /// blocks, both), spheres pushed after the padding was laid (each push is padded again), unequal
+    /// blocks, both), spheres filled over an earlier filling, unequal
     /// image radii (zero ones too, as Oseen's), heights from one radius to far above, and rows
     /// split into ranges (as the parallel chunks split them). Tolerance 1e-12 of the largest
     /// velocity: the two differ by summation order, Horner chains against expanded powers and
@@ -333,12 +321,13 @@ mod tests {
                         random(&mut seed) - 0.5,
                         random(&mut seed) - 0.5,
                     ) * 1e-12;
-                    s.push(&x, a, &f);
-                    s.pad();
                     pos.push(x);
                     radii.push(a);
                     forces.push(f);
                 }
+                // Filled twice: the second filling replaces the first, padding and all.
+                s.fill(pos.iter().rev().zip([2e-6; 40]).zip(&forces));
+                s.fill(pos.iter().zip(radii.iter().copied()).zip(&forces));
                 let scale = 8.0 * PI * MU;
                 let expected: Vec<Vector3<f64>> = (0..n)
                     .map(|i| {

@@ -73,6 +73,16 @@ fn wall_pair_terms(soa: &WallSpheres, parts: &mut Vec<WallVelocities>) {
         });
 }
 
+/// The radius a sphere of radius `a` has in the pair image system of `kind`: RPY's pairs take
+/// both spheres' Faxén operators, Oseen's Blake's point-force image (radius 0).
+#[inline]
+fn image_radius(kind: Mobility, a: f64) -> f64 {
+    match kind {
+        Mobility::Rpy => a,
+        Mobility::Oseen => 0.0,
+    }
+}
+
 /// Spheres in a fluid of viscosity `mu` above the no-slip plane of `wall`.
 #[derive(Debug, Clone)]
 pub struct WallMobility {
@@ -114,10 +124,7 @@ impl WallMobility {
     /// The radius a sphere of radius `a` has in the pair image system of this kind.
     #[inline]
     fn image_radius(&self, a: f64) -> f64 {
-        match self.kind {
-            Mobility::Rpy => a,
-            Mobility::Oseen => 0.0,
-        }
+        image_radius(self.kind, a)
     }
 
     /// [`Wall::lift`].
@@ -251,11 +258,10 @@ impl MobilityOperator for WallMobility {
         // the open tensor is invariant under the common shift by the wall's height). The two
         // sums are independent: from PARALLEL_IMAGE_SPHERES spheres on they run side by side
         // on rayon's threads (each as it would alone, so the result does not depend on it).
-        self.soa.clear();
-        for ((x, &a), f) in self.lifted.iter().zip(radii).zip(&self.damped) {
-            self.soa.push(x, self.image_radius(a), f);
-        }
-        self.soa.pad();
+        let kind = self.kind;
+        let image_radii = radii.iter().map(|&a| image_radius(kind, a));
+        self.soa
+            .fill(self.lifted.iter().zip(image_radii).zip(&self.damped));
         let (open, lifted, damped, soa) = (&mut self.open, &self.lifted, &self.damped, &self.soa);
         let parts = &mut self.parts;
         let mut open_pairs = || open.interaction_velocities(lifted, radii, damped, out);
