@@ -154,6 +154,8 @@ pub trait SceneView {
     fn ewald_method(&self) -> EwaldMethod;
     /// What the integrator policy reads.
     fn facts(&self) -> Facts;
+    /// The integrator the scene runs (set, or the model's default).
+    fn integrator(&self) -> IntegratorSpec;
     /// Whether the gpu backend is chosen.
     fn on_gpu(&self) -> bool;
     /// Whether the scene is crowded: a periodic box, a cutoff, steric repulsion or many swimmers

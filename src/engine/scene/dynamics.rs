@@ -316,6 +316,10 @@ impl SceneView for Scene {
         Scene::facts(self)
     }
 
+    fn integrator(&self) -> IntegratorSpec {
+        Scene::integrator(self)
+    }
+
     fn on_gpu(&self) -> bool {
         self.backend == Backend::Gpu
     }
