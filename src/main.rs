@@ -131,6 +131,7 @@ impl From<BenchKind> for swimlab::bench::report::Kind {
             BenchKind::Scaling => Kind::Scaling,
             BenchKind::Ewald => Kind::Ewald,
             BenchKind::Boundaries { ewald_tol } => Kind::Boundaries { ewald_tol },
+            BenchKind::Contacts => Kind::Contacts,
             BenchKind::Suspension => Kind::Suspension,
             BenchKind::View => Kind::View,
         }
@@ -168,6 +169,12 @@ enum BenchKind {
         #[arg(long, value_name = "TOL")]
         ewald_tol: Option<f64>,
     },
+    /// Whole runs of the spring and rigid-stroke models' suspensions in contact (~1 min; --quick:
+    /// a few seconds): the density study's 64 swimmers at volume fraction 1% with its rod
+    /// repulsion, from placement at auto(1e-4), in open space and in a periodic box, and the
+    /// first twentieth of a period of 1,000 rigid swimmers; seconds, right-hand sides and steps
+    /// a period.
+    Contacts,
     /// Bulk suspensions of the averaged model (~15 min; --quick: ~1 min): one right-hand side of
     /// 10,000 swimmers in a box with a cutoff against 1,024 all pairs, side by side; add_random of
     /// 100,000; suspension(tol)'s error against RK4 and its order; runs of 1,000 and 10,000

@@ -839,6 +839,21 @@ fn bench_boundaries_times_every_boundary() {
     assert!(e.contains("Ewald tolerance") && e.contains("1e-2"), "{e}");
 }
 
+/// `swimlab bench contacts --quick`: each of its runs (both accurate models, open space and the
+/// box) reports finite, positive seconds, right-hand sides and steps a period, right-hand sides
+/// at least the steps (an adaptive step takes at least one), and the table has a row a run.
+#[test]
+fn bench_contacts_runs_every_scene() {
+    use swimlab::bench::contacts::{run, table};
+    let rows = run(true).unwrap();
+    assert_eq!(rows.len(), 4);
+    for r in &rows {
+        assert!(r.seconds.is_finite() && r.seconds > 0.0, "{r:?}");
+        assert!(r.steps > 0.0 && r.rhs >= r.steps, "{r:?}");
+    }
+    assert_eq!(table(&rows).rows.len(), 4);
+}
+
 /// A box too elongated for the spectral grid: "spectral" says so and names the fixes, "auto"
 /// sums by Beenakker's method instead.
 #[test]

@@ -3,6 +3,7 @@
 
 pub mod backends;
 pub mod boundaries;
+pub mod contacts;
 pub mod ewald;
 pub mod live_view;
 pub mod pairs;

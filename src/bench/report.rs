@@ -2,7 +2,7 @@
 //! under out/bench/. The command line only names the benchmark.
 
 use super::{
-    backends, boundaries, ewald, live_view, pairs, plots, scaling, stability, suspension,
+    backends, boundaries, contacts, ewald, live_view, pairs, plots, scaling, stability, suspension,
     work_precision,
 };
 use crate::engine::Model;
@@ -27,6 +27,9 @@ pub enum Kind {
         /// The box's Ewald tolerance (`None`: the scene's default).
         ewald_tol: Option<f64>,
     },
+    /// Whole runs of the accurate models' suspensions in contact: seconds and right-hand sides
+    /// a period.
+    Contacts,
     /// Bulk suspensions of the averaged model: right-hand side, placement, long runs, accuracy.
     Suspension,
     /// A run with and without a live view attached (and with readers that never read).
@@ -193,6 +196,20 @@ fn run_kind(
             plots::scaling(&rows).save(std::path::Path::new("out/bench/scaling.png"))?;
             say("picture: out/bench/scaling.png")?;
             say("\nCSV written to out/bench/scaling.csv")?;
+        }
+        Kind::Contacts => {
+            let rows = contacts::run(quick)?;
+            let t = contacts::table(&rows);
+            say(&format!(
+                "whole runs from placement at auto({}), the density study's swimmers and contact law at sphere volume fraction {}, seed 1001 ({} threads):\n{}",
+                contacts::TOL,
+                contacts::PHI,
+                rayon::current_num_threads(),
+                t.render()
+            ))?;
+            t.write_csv(std::path::Path::new("out/bench/contacts.csv"))
+                .map_err(io)?;
+            say("\nCSV written to out/bench/contacts.csv")?;
         }
         Kind::Suspension => run_suspension(quick, say)?,
         Kind::View => {
