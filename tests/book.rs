@@ -225,3 +225,100 @@ fn readme_stays_a_front_door() {
         "README.md has {lines} lines; the detail belongs in the book"
     );
 }
+
+/// The design notes' places hold: every source path they name (in backticks) exists, a bare
+/// file name relative to the last path before it in its paragraph (or a folder above it); every
+/// constant (`UPPER_CASE`) is defined in a file its paragraph names; and a name written
+/// "`Name` in `path`" is defined in that file.
+#[test]
+fn the_design_notes_name_places_that_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("docs/src/design-notes.md")).unwrap();
+    let mut problems = Vec::new();
+    for paragraph in text.split("\n\n") {
+        let ticks: Vec<&str> = paragraph.split('`').skip(1).step_by(2).collect();
+        let is_path = |t: &str| {
+            [".rs", ".md", ".wgsl", ".toml", ".rhai"]
+                .iter()
+                .any(|e| t.ends_with(e))
+                && !t.contains(' ')
+        };
+        let mut last: Option<PathBuf> = None;
+        let mut files: Vec<PathBuf> = Vec::new();
+        for t in &ticks {
+            // A folder: bare names after it are looked up in it.
+            if t.ends_with('/') && !t.contains(' ') && root.join(t).is_dir() {
+                last = Some(root.join(t).join("-"));
+                continue;
+            }
+            if !is_path(t) || t.contains('*') {
+                continue;
+            }
+            let found = if t.contains('/') && root.join(t).exists() {
+                Some(root.join(t))
+            } else {
+                last.as_ref().and_then(|l| {
+                    l.ancestors()
+                        .skip(1)
+                        .take_while(|a| a.starts_with(root) && *a != root)
+                        .map(|a| a.join(t))
+                        .find(|p| p.exists())
+                })
+            };
+            match found {
+                Some(p) => {
+                    if p.extension().is_some_and(|e| e == "rs") {
+                        files.push(p.clone());
+                    }
+                    last = Some(p);
+                }
+                None => problems.push(format!("`{t}` does not exist")),
+            }
+        }
+        let defines = |file: &Path, name: &str| {
+            let src = std::fs::read_to_string(file).unwrap_or_default();
+            [
+                "const ", "static ", "struct ", "enum ", "trait ", "fn ", "type ", "mod ",
+            ]
+            .iter()
+            .any(|k| {
+                src.match_indices(&format!("{k}{name}")).any(|(i, _)| {
+                    let after = src[i + k.len() + name.len()..].chars().next();
+                    !after.is_some_and(|c| c.is_alphanumeric() || c == '_')
+                })
+            })
+        };
+        for t in &ticks {
+            let constant = t.len() > 2
+                && t.contains('_')
+                && t.chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_');
+            if constant && !files.iter().any(|f| defines(f, t)) {
+                problems.push(format!(
+                    "`{t}` is defined in none of the files its paragraph names ({})",
+                    files
+                        .iter()
+                        .map(|f| f.strip_prefix(root).unwrap().display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
+        }
+        for (i, piece) in paragraph.split('`').enumerate() {
+            // "`Name` in `path`": the piece after a name is " in ", then the path.
+            if i % 2 == 0 || i + 2 >= paragraph.split('`').count() {
+                continue;
+            }
+            let pieces: Vec<&str> = paragraph.split('`').collect();
+            let ident = piece.chars().all(|c| c.is_alphanumeric() || c == '_')
+                && piece.chars().next().is_some_and(|c| c.is_ascii_uppercase());
+            if ident && pieces[i + 1] == " in " && is_path(pieces[i + 2]) {
+                let file = root.join(pieces[i + 2]);
+                if file.exists() && !defines(&file, piece) {
+                    problems.push(format!("`{piece}` is not defined in `{}`", pieces[i + 2]));
+                }
+            }
+        }
+    }
+    assert!(problems.is_empty(), "the design notes: {problems:#?}");
+}

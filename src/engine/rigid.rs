@@ -301,50 +301,46 @@ impl SwimmerModel for RigidStrokes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::build::{random_suspension_apart, Orientations, Phases};
-    use crate::engine::contacts::{Overlaps, StericBody, StericLaw};
+    use crate::engine::contacts::{Steric, StericBody, StericLaw};
     use crate::engine::integrators::{Dopri5, Stats, Stepper};
     use crate::engine::tensions::{tension_rtol_for, Route, TENSION_RTOL};
-    use crate::engine::Scene;
 
-    /// 16 of the study's swimmers at φ = 1% in open space, 0.3 µm apart (contacts from the
-    /// start, the study's rod repulsion), integrated over 0.2 period by Dormand-Prince at
-    /// `rtol`, their tensions iterated to `tension_rtol`: the final state and the right-hand
-    /// sides taken.
+    /// 16 of the density study's swimmers (a1 = 0.225ℓ, a2 = a1/2) in open space, as 8 side by
+    /// side pairs whose big spheres start 0.3 µm apart, inside the study's rod repulsion (0.5
+    /// µm, 1e-3 N/m, smooth), the pairs 3ℓ apart on a cube's corners, tilted and phased apart,
+    /// integrated over 0.2 period by Dormand-Prince at `rtol`, their tensions iterated to
+    /// `tension_rtol`: the final state, the right-hand sides taken and the error scale.
     fn run(rtol: f64, tension_rtol: f64) -> (Vec<f64>, u64, Vec<f64>) {
         let d = Dumbbell {
             a1: 1.125e-6,
             a2: 0.5625e-6,
             ..Dumbbell::default()
         };
-        let v = 4.0 / 3.0 * std::f64::consts::PI * (d.a1.powi(3) + d.a2.powi(3));
-        let side = (16.0 * v / 0.01).cbrt();
-        let mut s = Scene::new();
-        random_suspension_apart(
-            &mut s,
-            16,
-            d,
-            [side; 3],
-            Orientations::Random,
-            Phases::Random,
-            1001,
-            Some(0.3e-6),
-        )
-        .unwrap();
-        let steric = crate::engine::contacts::Steric::new(0.5e-6, 1e-3)
+        let (mut swimmers, mut base, mut y) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..8 {
+            let corner = Vector3::new((k & 1) as f64, ((k >> 1) & 1) as f64, (k >> 2) as f64);
+            let tilt = 0.1 * k as f64;
+            let n = Vector3::new(tilt.cos(), 0.0, tilt.sin());
+            for (side, phase) in [(-0.5, 0.3 * k as f64), (0.5, 0.3 * k as f64 + 1.9)] {
+                swimmers.push(Dumbbell { phase, ..d });
+                base.push(corner * 3.0 * d.ell + Vector3::y() * side * (2.0 * d.a1 + 0.3e-6));
+                y.extend([0.0, 0.0, 0.0, n.x, n.y, n.z]);
+            }
+        }
+        let steric = Steric::new(0.5e-6, 1e-3)
             .unwrap()
             .with_body(StericBody::Rods)
             .with_law(StericLaw::Smooth);
-        s.set_steric(Some(steric));
-        s.set_overlaps(Overlaps::Allow);
-        s.set_model(Model::Rigid);
-        let mut sys = rigid_system(&s).unwrap();
+        let contacts = Contacts {
+            allow_overlap: true,
+            steric: Some(steric),
+        };
+        let mut sys = RigidSystem::new(&swimmers, &base, 1e-3, Mobility::Rpy, contacts);
         sys.set_tension_rtol(tension_rtol);
         assert!(matches!(sys.tension_solver().route(), Route::Pairs));
-        let mut y = s.state().to_vec();
         let mut stepper = Dopri5::new(rtol);
         let mut stats = Stats::default();
-        let (mut t, end) = (0.0, 0.2 * s.shortest_period());
+        let (mut t, end) = (0.0, 0.2 * shortest_period(&swimmers));
         while t < end {
             t = stepper.step(&mut sys, t, &mut y, end, &mut stats).unwrap();
         }
@@ -359,8 +355,8 @@ mod tests {
     /// right-hand sides within 5% (a residual rough at the step estimate's level shortens the
     /// steps: at 10 times the step tolerance a box run took 1.46 times as many) and a state, in
     /// units of the run's error scale, off the tight run's by at most a fifth of that run's own
-    /// error against dopri5(1e-10) (measured: 0.09). A rule a hundred times looser adds more
-    /// than the run's own error (measured: 9 times), so the margin is needed.
+    /// error against dopri5(1e-10) (measured: 0.07). A rule a hundred times looser adds more
+    /// than the run's own error (measured: 4.5 times), so the margin is needed.
     #[test]
     fn the_tension_rule_costs_the_run_no_accuracy_and_no_steps() {
         let rule = tension_rtol_for(Some(1e-7));
