@@ -144,3 +144,28 @@ fn extreme_numbers_in_refusals_are_written_compactly() {
     assert!(!t.contains("00000000000000000000"), "{t}");
     assert!(!t.contains("from 0 to 3600"), "{t}");
 }
+
+/// A call of one of Rhai's own functions (`split`, `trim`) with arguments none of its forms
+/// takes names that function and its forms, caught or not: not Rhai's error map with Rust's
+/// spelling of the types, and not "there is no function split; did you mean plot?".
+#[test]
+fn a_wrong_call_of_a_core_function_names_its_forms() {
+    let t = case(
+        "let x = ();\ntry { x.split(\",\"); } catch (e) { print(e); }\nprint(\"a,b\".split(\",\"));\nlet a = [1];\na.push(2);\nprint(a);\nprint(timestamp().elapsed >= 0.0);\nx.split(\",\");",
+        &[
+            "split cannot be called as split((), string); its forms: split(string), ",
+            "split(string, string)",
+            "[\"a\", \"b\"]",
+            "[1, 2]",
+            "true",
+            ":8:3: split cannot be called as split((), string); its forms:",
+        ],
+        1,
+    );
+    assert!(
+        !t.contains("ImmutableString")
+            && !t.contains("ErrorFunctionNotFound")
+            && !t.contains("did you mean plot"),
+        "{t}"
+    );
+}
