@@ -419,6 +419,62 @@ fn a_view_stops_with_its_scene_or_close_view() {
     r.unwrap();
 }
 
+/// A recorder keeps its scene, not the scene's view: replacing or dropping the script's scene
+/// while a recorder of it is held stops the view, as the book says ("nothing is left listening").
+#[test]
+fn a_view_stops_with_its_scene_while_a_recorder_holds_it() {
+    let (scope, r) = script(
+        "let s = scene(); s.add(dumbbell()); let url = s.view(); let rec = s.record([msd()], 1); s.run_periods(1); s = scene(); let rows = rec.len;",
+    );
+    r.unwrap();
+    let url = scope.get_value::<rhai::ImmutableString>("url").unwrap();
+    assert!(
+        TcpStream::connect(addr_of(&url)).is_err(),
+        "the replaced scene's view still listens while its recorder is held"
+    );
+    assert_eq!(scope.get_value::<rhai::INT>("rows"), Some(2));
+    // While the scene lives, the recorder changes nothing: its view serves.
+    let (scope, r) = script(
+        "let s = scene(); s.add(dumbbell()); let url = s.view(); let rec = s.record([msd()], 1); s.run_periods(1);",
+    );
+    r.unwrap();
+    let url = scope.get_value::<rhai::ImmutableString>("url").unwrap();
+    assert_eq!(
+        request(addr_of(&url), "GET", &format!("{}frame", path_of(&url))).0,
+        200
+    );
+}
+
+/// `swimlab run --view` after the script closed its only view says so, not that it started none.
+#[test]
+fn run_with_view_after_close_view_says_the_views_were_stopped() {
+    let dir = cli_dir("close");
+    std::fs::write(
+        dir.join("closed.rhai"),
+        "let s = scene(); s.add(dumbbell()); s.view(); s.close_view();\n",
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", "closed.rhai", "--view"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("every view the script started was stopped before it ended (s.close_view())"),
+        "{err}"
+    );
+    assert!(!err.contains("started no view"), "{err}");
+}
+
+/// A fresh folder for a test that runs the binary.
+fn cli_dir(what: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("swimlab-view-{what}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 #[test]
 fn changes_between_runs_show_at_once() {
     let (scope, r) = script(
@@ -487,6 +543,25 @@ fn bad_views_are_clear_messages_and_leave_nothing_listening() {
     refused(
         &format!("{s}s.view(#{{ pace: -1 }});"),
         &["pace is the most stroke periods"],
+    );
+    // A pace that underflows to no time (it ran at full speed) or that would hold a run for
+    // ever: refused with the least pace taken.
+    for (pace, shown) in [
+        ("5e-324", "5e-324"),
+        ("1e-300", "1e-300"),
+        ("2e-5", "0.00002"),
+    ] {
+        refused(
+            &format!("{s}s.view(#{{ pace: {pace} }});"),
+            &[
+                "a number from 1e-4 (a period in under three hours) up",
+                &format!("got {shown}"),
+            ],
+        );
+    }
+    refused(
+        &format!("{s}s.view(#{{ every: 0 }});"),
+        &["above 0 and at most 3600 s"],
     );
     refused(
         &format!("{s}s.view(#{{ fields: [\"sphere\"] }});"),
