@@ -371,6 +371,124 @@ fn a_wrong_token_is_404_and_anything_but_get_is_405() {
     assert_ne!(path_of(second.url()), path);
 }
 
+/// Send `bytes` as they are and read the answer until the server closes: its status code (0 for
+/// none).
+fn raw(addr: SocketAddr, bytes: &[u8]) -> u16 {
+    let mut c = TcpStream::connect(addr).unwrap();
+    c.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    c.write_all(bytes).unwrap();
+    let mut text = Vec::new();
+    let _ = c.read_to_end(&mut text);
+    String::from_utf8_lossy(&text)
+        .split_whitespace()
+        .nth(1)
+        .and_then(|w| w.parse().ok())
+        .unwrap_or(0)
+}
+
+/// A broken request line is answered 400 (TLS bytes at once, not after a timeout), a head over
+/// 16 KiB 431, an HTTP version other than 1.0 and 1.1 505, each then closed.
+#[test]
+fn broken_requests_are_answered_400_431_or_505() {
+    let mut sim = Simulation::new(pair(Vector3::zeros()));
+    let server = serve(&mut sim, None);
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    assert_eq!(raw(addr, b"hello there\r\n\r\n"), 400);
+    assert_eq!(raw(addr, b"GET\r\n\r\n"), 400);
+    assert_eq!(
+        raw(addr, format!("GET {path}frame\r\n\r\n").as_bytes()),
+        400
+    );
+    assert_eq!(
+        raw(addr, format!("GET {path}frame HTTP/x\r\n\r\n").as_bytes()),
+        400
+    );
+    let started = Instant::now();
+    assert_eq!(
+        raw(addr, &[0x16, 0x03, 0x01, 0x02, 0x00, 0x01, 0x00, 0x01]),
+        400
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(4),
+        "TLS bytes waited for the head's deadline"
+    );
+    for version in ["HTTP/2.0", "HTTP/0.9", "HTTP/3"] {
+        let head = format!("GET {path}frame {version}\r\nHost: x\r\n\r\n");
+        assert_eq!(raw(addr, head.as_bytes()), 505, "{version}");
+    }
+    let long = format!(
+        "GET {path}frame HTTP/1.1\r\nX-Long: {}\r\n",
+        "a".repeat(17 * 1024)
+    );
+    assert_eq!(raw(addr, long.as_bytes()), 431);
+    let head = format!("GET {path}frame HTTP/1.0\r\n\r\n");
+    assert_eq!(raw(addr, head.as_bytes()), 200);
+}
+
+/// Slow clients cannot lock an honest one out: with 70 connections that trickle their head a
+/// byte at a time and 70 that send nothing, an honest `GET TOKEN/frame` is answered 200, and
+/// the trickling ones are cut off at the head's deadline (5 s for the whole head, however often
+/// they send), well within the loop's bound.
+#[test]
+fn slow_clients_do_not_lock_out_an_honest_one() {
+    let mut sim = Simulation::new(pair(Vector3::zeros()));
+    let server = serve(&mut sim, None);
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    let mut slow: Vec<TcpStream> = (0..70)
+        .map(|_| {
+            let mut c = TcpStream::connect(addr).unwrap();
+            c.write_all(b"G").unwrap();
+            c
+        })
+        .collect();
+    let idle: Vec<TcpStream> = (0..70).map(|_| TcpStream::connect(addr).unwrap()).collect();
+    let (code, _) = request(addr, "GET", &format!("{path}frame"));
+    assert_eq!(code, 200, "an honest client locked out by slow ones");
+    // The slow clients go on sending a byte every 100 ms; by 15 s every one is cut off.
+    let started = Instant::now();
+    let mut open = slow.len();
+    while open > 0 && started.elapsed() < Duration::from_secs(15) {
+        open = 0;
+        for c in &mut slow {
+            if c.write_all(b"E").is_ok() {
+                open += 1;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    for c in &mut slow {
+        c.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        let mut rest = Vec::new();
+        assert!(
+            c.read_to_end(&mut rest).is_ok() || started.elapsed() < Duration::from_secs(20),
+            "a trickling client is still served"
+        );
+    }
+    assert!(
+        started.elapsed() < Duration::from_secs(15),
+        "trickling clients were not cut off at the head's deadline"
+    );
+    drop(idle);
+}
+
+/// Many views start and stop without each stop waiting out a poll of its accepting thread
+/// (each waited up to 20 ms): 300 stop well within a generous bound.
+#[test]
+fn many_views_stop_promptly() {
+    let servers: Vec<Server> = (0..300)
+        .map(|_| Server::start(Arc::new(Slot::default()), &ServerOptions::default()).unwrap())
+        .collect();
+    let addrs: Vec<SocketAddr> = servers.iter().map(Server::local_addr).collect();
+    let started = Instant::now();
+    drop(servers);
+    let took = started.elapsed();
+    assert!(
+        took < Duration::from_secs(2),
+        "300 views took {took:?} to stop"
+    );
+    assert!(addrs.iter().all(|a| TcpStream::connect(a).is_err()));
+}
+
 /// Run `source` in-process; the script's variables are returned in its scope, the error as text.
 fn script(source: &str) -> (rhai::Scope<'static>, Result<(), String>) {
     let mut scope = rhai::Scope::new();
