@@ -600,12 +600,69 @@ fn changes_between_runs_show_at_once() {
     );
     r.unwrap();
     let url = scope.get_value::<rhai::ImmutableString>("url").unwrap();
-    let (code, body) = request(addr_of(&url), "GET", &format!("{}frame", path_of(&url)));
-    assert_eq!(code, 200);
-    let f: Value = serde_json::from_str(&body).unwrap();
+    // The changes came within a frame's interval of the view's start: the last is drawn when
+    // the next frame is due (1/30 s later), without a run.
+    let started = Instant::now();
+    let f = loop {
+        let (code, body) = request(addr_of(&url), "GET", &format!("{}frame", path_of(&url)));
+        assert_eq!(code, 200);
+        let f: Value = serde_json::from_str(&body).unwrap();
+        if !f["box"].is_null() || started.elapsed() > Duration::from_secs(10) {
+            break f;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
     assert_eq!(f["spheres"].as_array().unwrap().len(), 2, "{f}");
     assert_eq!(f["box"], serde_json::json!([40e-6, 40e-6, 40e-6]));
     assert_eq!(f["t"].as_f64(), Some(0.0));
+}
+
+/// Changes between runs are drawn at the view's rate, not each as it is made: 2,000 swimmers
+/// added one by one with a view open take a few frames (one per 50 ms interval at most, and
+/// fewer as the frames grow), not 2,000; the last change is still drawn, soon after.
+#[test]
+fn changes_between_runs_are_drawn_at_the_views_rate() {
+    let sim = Arc::new(std::sync::RwLock::new(Simulation::new(Scene::new())));
+    let slot = Arc::new(Slot::default());
+    let weak = Arc::downgrade(&sim);
+    let refresh: swimlab::view::Refresh = Arc::new(move || {
+        if let Some(sim) = weak.upgrade() {
+            sim.read().unwrap().show_watcher();
+        }
+    });
+    let every = Duration::from_millis(50);
+    let publisher =
+        Publisher::new(slot.clone(), Parts::default(), every, None).with_refresh(refresh);
+    sim.write().unwrap().set_watcher(Some(Arc::new(publisher)));
+    let started = Instant::now();
+    for k in 0..2000 {
+        let mut s = sim.write().unwrap();
+        let c = Vector3::new(k as f64 * 20e-6, 0.0, 0.0);
+        s.scene_mut()
+            .add(Dumbbell::default(), c, Vector3::x())
+            .unwrap();
+        s.show_change();
+    }
+    let took = started.elapsed();
+    let frames = slot.published();
+    let most = 2 + (took.as_secs_f64() / every.as_secs_f64()) as u64;
+    assert!(
+        frames <= most,
+        "{frames} frames for 2000 changes in {took:?}"
+    );
+    // The last change is drawn when the next frame is due.
+    let waited = Instant::now();
+    loop {
+        let f: Value = serde_json::from_str(&slot.latest().unwrap()).unwrap();
+        if f["spheres"].as_array().unwrap().len() == 4000 {
+            break;
+        }
+        assert!(
+            waited.elapsed() < Duration::from_secs(10),
+            "the last change was not drawn"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }
 
 #[track_caller]

@@ -122,6 +122,17 @@ impl SceneHandle {
         Arc::ptr_eq(&self.sim, &other.sim)
     }
 
+    /// Shows the scene's watcher (its live view) the scene as it is, from any thread, while the
+    /// scene lives: the view's late drawing of a change.
+    pub(super) fn redraw(&self) -> crate::view::Refresh {
+        let sim = Arc::downgrade(&self.sim);
+        Arc::new(move || {
+            if let Some(sim) = sim.upgrade() {
+                sim.read().unwrap_or_else(|e| e.into_inner()).show_watcher();
+            }
+        })
+    }
+
     /// The scene's live view, if one is served.
     pub(super) fn view(&self) -> std::sync::MutexGuard<'_, Option<Arc<Server>>> {
         self.view.lock().unwrap_or_else(|e| e.into_inner())
@@ -171,7 +182,7 @@ impl SceneHandle {
     ) -> ScriptResult<T> {
         let mut sim = self.borrow_mut()?;
         let result = f(sim.scene_mut());
-        sim.show_watcher();
+        sim.show_change();
         lift(result)
     }
 
@@ -187,7 +198,7 @@ impl SceneHandle {
     pub(super) fn replace(&self, trial: Scene) -> ScriptResult<INT> {
         let mut sim = self.borrow_mut()?;
         sim.replace_scene(trial);
-        sim.show_watcher();
+        sim.show_change();
         Ok(sim.count() as INT)
     }
 }

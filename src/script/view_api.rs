@@ -265,7 +265,8 @@ fn view(s: &mut SceneHandle, opts: &Map) -> ScriptResult<ImmutableString> {
     };
     let slot = Arc::new(Slot::default());
     let server = Server::start(slot.clone(), &o.server).map_err(|e| bind_error(&e, &o.server))?;
-    sim.set_watcher(Some(Arc::new(Publisher::new(slot, o.parts, o.every, pace))));
+    let publisher = Publisher::new(slot, o.parts, o.every, pace).with_refresh(s.redraw());
+    sim.set_watcher(Some(Arc::new(publisher)));
     drop(sim);
     let server = Arc::new(server);
     let url = server.url().to_string();
