@@ -627,7 +627,7 @@ fn changes_between_runs_are_drawn_at_the_views_rate() {
     let weak = Arc::downgrade(&sim);
     let refresh: swimlab::view::Refresh = Arc::new(move || {
         if let Some(sim) = weak.upgrade() {
-            sim.read().unwrap().show_watcher();
+            sim.read().unwrap().show_change();
         }
     });
     let every = Duration::from_millis(50);

@@ -122,13 +122,13 @@ impl SceneHandle {
         Arc::ptr_eq(&self.sim, &other.sim)
     }
 
-    /// Shows the scene's watcher (its live view) the scene as it is, from any thread, while the
-    /// scene lives: the view's late drawing of a change.
+    /// Shows the scene's watcher (its live view) the scene as it is as a change, from any
+    /// thread, while the scene lives: the view's late drawing of a change, at the view's rate.
     pub(super) fn redraw(&self) -> crate::view::Refresh {
         let sim = Arc::downgrade(&self.sim);
         Arc::new(move || {
             if let Some(sim) = sim.upgrade() {
-                sim.read().unwrap_or_else(|e| e.into_inner()).show_watcher();
+                sim.read().unwrap_or_else(|e| e.into_inner()).show_change();
             }
         })
     }

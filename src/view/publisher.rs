@@ -31,8 +31,8 @@ const PACE_NAP: Duration = Duration::from_millis(20);
 /// A paced run sleeps only when it is ahead of the clock by more than this.
 const PACE_SLACK: Duration = Duration::from_millis(2);
 
-/// Shows the watched simulation's scene as it is now ([`crate::engine::Simulation::show_watcher`]
-/// under its lock), for a change drawn late.
+/// Tells the watched simulation's watcher of its scene as it is now, as a change
+/// ([`crate::engine::Simulation::show_change`] under its lock): a change drawn late, when due.
 pub type Refresh = Arc<dyn Fn() + Send + Sync>;
 
 /// A change waiting to be drawn, shared with the thread that waits for its due time.

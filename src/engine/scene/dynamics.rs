@@ -70,7 +70,7 @@ impl Scene {
         let half = 0.5 * b.shortest();
         if st.range > half {
             return Err(invalid!(
-                "the steric range {} m is longer than half the box's shortest side ({} m): every pair would repel through a minimum image; set a range up to {} m (a small fraction of a sphere radius is usual, such as s.steric = #{{ range: 1e-7, stiffness: 1e-3 }}), or use a larger box",
+                "the steric range {} m is longer than half the box's shortest side ({} m): every pair would repel through a minimum image; set a range up to {} m (a small fraction of a sphere radius is usual, such as 1e-7 m), or use a larger box",
                 short(st.range),
                 short(half),
                 short(half)
