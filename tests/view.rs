@@ -471,6 +471,21 @@ fn slow_clients_do_not_lock_out_an_honest_one() {
     drop(idle);
 }
 
+/// Past the bound on connections reading their head (256), a new one cuts off the one that has
+/// waited longest: 270 idle connections do not keep an honest client out either.
+#[test]
+fn idle_connections_past_the_bound_do_not_lock_out_an_honest_one() {
+    let mut sim = Simulation::new(pair(Vector3::zeros()));
+    let server = serve(&mut sim, None);
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    let idle: Vec<TcpStream> = (0..270)
+        .map(|_| TcpStream::connect(addr).unwrap())
+        .collect();
+    let (code, _) = request(addr, "GET", &format!("{path}frame"));
+    assert_eq!(code, 200, "an honest client locked out by idle ones");
+    drop(idle);
+}
+
 /// Many views start and stop without each stop waiting out a poll of its accepting thread
 /// (each waited up to 20 ms): 300 stop well within a generous bound.
 #[test]
