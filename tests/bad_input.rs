@@ -309,6 +309,13 @@ fn set_values_are_read_or_refused() {
     );
     let out = swimlab(&["run", f, "--set", "DD=10"], "", &d);
     check("unused --set", &out, "the script never reads DD", 1);
+    let out = swimlab(&["run", f, "--set", "D=2", "--set", "D=3"], "", &d);
+    check(
+        "repeated --set",
+        &out,
+        "--set D is given twice (D=2 and D=3); give each name once",
+        1,
+    );
     std::fs::write(&file, "let D = param(\"D\", 4.0);\nprint(`D=${D}`);\n").unwrap();
     let out = swimlab(&["run", f, "--set", "D=10"], "", &d);
     check("param with --set", &out, "D=10", 0);

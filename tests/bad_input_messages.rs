@@ -121,3 +121,51 @@ fn a_data_race_is_explained() {
     );
     assert!(!text.contains("Data race detected"), "{text}");
 }
+
+/// Refusals name extreme numbers compactly: 1e308 as "1e308", not as 309 digits, whether the
+/// message comes from the engine or the script layer, caught or not; numbers of ordinary size,
+/// and digits inside words, are written as before.
+#[test]
+fn extreme_numbers_in_refusals_are_written_compactly() {
+    let t = case(
+        "let s = scene();\ns.add(dumbbell());\ntry { s.temperature = 1e308; } catch (e) { print(e); }\ntry { s.mu = -1e308; } catch (e) { print(e); }\ntry { s.run_periods(-1e308); } catch (e) { print(e); }\ntry { s.view(#{ every: 1e308 }); } catch (e) { print(e); }\ntry { s.view(#{ every: 0 }); } catch (e) { print(e); }\ntry { s.view(#{ pace: -1e308 }); } catch (e) { print(e); }\ntry { s.view(#{ every: -1e-320 }); } catch (e) { print(e); }\ns.ewald_tol = 1e308;",
+        &[
+            "temperature must lie between 0 and 1e6 K, got 1e308",
+            "mu must be a finite positive number (Pa s), got -1e308",
+            "the number of periods must be >= 0, got -1e308",
+            "above 0 and at most 3600 s (default 0.0333 s: 30 frames a second), got 1e308",
+            "above 0 and at most 3600 s (default 0.0333 s: 30 frames a second), got 0\n",
+            "got -1e308\n",
+            "got -1e-320\n",
+            ":10:3: the Ewald tolerance must lie between 1e-15 and 1e-2, got 1e308",
+        ],
+        1,
+    );
+    assert!(!t.contains("00000000000000000000"), "{t}");
+    assert!(!t.contains("from 0 to 3600"), "{t}");
+}
+
+/// A call of one of Rhai's own functions (`split`, `trim`) with arguments none of its forms
+/// takes names that function and its forms, caught or not: not Rhai's error map with Rust's
+/// spelling of the types, and not "there is no function split; did you mean plot?".
+#[test]
+fn a_wrong_call_of_a_core_function_names_its_forms() {
+    let t = case(
+        "let x = ();\ntry { x.split(\",\"); } catch (e) { print(e); }\nprint(\"a,b\".split(\",\"));\nlet a = [1];\na.push(2);\nprint(a);\nprint(timestamp().elapsed >= 0.0);\nx.split(\",\");",
+        &[
+            "split cannot be called as split((), string); its forms: split(string), ",
+            "split(string, string)",
+            "[\"a\", \"b\"]",
+            "[1, 2]",
+            "true",
+            ":8:3: split cannot be called as split((), string); its forms:",
+        ],
+        1,
+    );
+    assert!(
+        !t.contains("ImmutableString")
+            && !t.contains("ErrorFunctionNotFound")
+            && !t.contains("did you mean plot"),
+        "{t}"
+    );
+}

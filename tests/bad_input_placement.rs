@@ -192,6 +192,63 @@ fn a_wall_in_the_way_of_a_placement_is_named() {
     );
 }
 
+/// A volume fraction so small that its cube reaches beyond the positions' reach (1e8 radii from
+/// the origin) is refused before a draw, as a centre placed there is, and the scene is left as
+/// it was: no swimmer lands 1e94 m out, where gaps report overlaps and a wall's mobility NaN.
+#[test]
+fn a_random_placement_is_held_to_the_reach_of_positions() {
+    case(
+        "let s = scene();
+try { s.add_random(dumbbell(), 4, 1e-300, 1); } catch (e) { print(e); }
+print(`count ${s.count}`);
+s.add_random(dumbbell(), 4, 1e-6, 1);
+print(`then ${s.count}`);",
+        &[
+            "swimmers drawn at random in a cube of side 2.42e94 m",
+            "beyond the 75 m that positions may reach",
+            "give a larger volume fraction",
+            "count 0",
+            "then 4",
+        ],
+        &[],
+        0,
+    );
+}
+
+/// A steric range beyond half the box's shortest side (every pair within it through a minimum
+/// image) is refused when the run starts, as the averaged model's cutoff is, naming the half
+/// side; up to it the run goes.
+#[test]
+fn a_steric_range_beyond_half_the_box_is_refused() {
+    let scene = "let s = scene();
+s.box = [40e-6, 40e-6, 40e-6];
+s.add_random(dumbbell(), 2, 1);
+s.overlaps = \"allow\";
+";
+    case(
+        &format!(
+            "{scene}s.steric = #{{ range: 2.5e-5, stiffness: 1e-3 }};
+s.run_periods(0.01);"
+        ),
+        &[
+            ":6:3: the steric range 2.5e-5 m is longer than half the box's shortest side (2e-5 m)",
+            "set a range up to 2e-5 m",
+        ],
+        &[],
+        1,
+    );
+    case(
+        &format!(
+            "{scene}s.steric = #{{ range: 1e-7, stiffness: 1e-3 }};
+s.run_periods(0.01);
+print(\"ran\");"
+        ),
+        &["ran"],
+        &[],
+        0,
+    );
+}
+
 /// With no swimmers, the scene-wide observables that have no value refuse, as `height(0)` does,
 /// instead of returning inf or 0; a recorder of them may still be set up before the swimmers.
 #[test]

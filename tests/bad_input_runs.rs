@@ -264,3 +264,48 @@ fn the_default_cutoff_of_a_box_keeps_the_lists_skin() {
     let t = case(&format!("{scene}s.run(1e-6);"), &[], &["note:"], 0);
     assert!(t.is_empty(), "{t}");
 }
+
+/// The rigid model in a box under a weight just below the runaway guard (density 1e12): its
+/// steps collapse to ~1e-9 s, and a tenth of a period would take hours. The run says so early,
+/// with the pace, the time the rest would take and the force behind it, rather than grinding
+/// on without a word (the test stops it once the notice is out).
+#[test]
+fn a_run_whose_steps_collapse_says_so_early() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    let dir = cli::case_dir();
+    std::fs::write(
+        dir.join("sink.rhai"),
+        "let s = scene();\ns.box = [40e-6, 40e-6, 40e-6];\ns.add_random(dumbbell(), 8, 1);\ns.model = \"rigid\";\ns.overlaps = \"allow\";\ns.gravity = #{ g: 9.81, density: 1e12, fluid_density: 1000.0 };\ns.run_periods(0.1);\n",
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", "sink.rhai"])
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                return;
+            }
+        }
+    });
+    let note = rx.recv_timeout(LIMIT);
+    let _ = child.kill();
+    let _ = child.wait();
+    let note = note.expect("no notice within the limit");
+    for fragment in [
+        "this run's steps have collapsed to ",
+        "of a stroke period",
+        "at this pace the 0.00126 s left to t = 0.00126 s take about ",
+        "the external forces drive sphere ",
+        "use a smaller external force or weaker gravity",
+    ] {
+        assert!(note.contains(fragment), "{fragment:?} not in:\n{note}");
+    }
+}

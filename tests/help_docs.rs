@@ -16,9 +16,23 @@ fn every_help_example_runs() {
 fn every_registered_name_has_help() {
     // Conversion and display hooks Rhai calls itself are not user vocabulary.
     let internal = ["to_string", "to_debug"];
+    // Rhai's own functions (`split`, `trim`) get forms that answer a wrong call with their call
+    // forms; those forms (untyped parameters, `_`) are Rhai's vocabulary, not swimlab's.
+    let rhai_names: Vec<String> = rhai::Engine::new()
+        .gen_fn_signatures(true)
+        .iter()
+        .map(|sig| sig.split('(').next().unwrap().trim().to_string())
+        .collect();
     let mut missing = Vec::new();
     for sig in engine().gen_fn_signatures(false) {
         let name = sig.split('(').next().unwrap();
+        let params = sig
+            .split_once('(')
+            .map_or("", |(_, rest)| rest.split(')').next().unwrap_or(""));
+        let answering = params.split(", ").all(|p| p.is_empty() || p == "_");
+        if answering && rhai_names.iter().any(|n| n == name) {
+            continue;
+        }
         let name = name.trim_start_matches("get$").trim_start_matches("set$");
         let is_ident = name
             .chars()

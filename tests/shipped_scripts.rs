@@ -153,3 +153,30 @@ fn set_exposes_values_and_e_evaluates() {
     let (ok, _, err) = swimlab(&["-e", "let s = scene(); s.model = \"x\""]);
     assert!(!ok && err.contains("unknown model"), "{err}");
 }
+
+/// The density study's settings are each checked by name with its range before anything runs:
+/// `seeds=0` is not an index error deep inside, `rows=0` not a division by zero, `seeds=1.5`
+/// not an operator error, `densities=0` not a box of side inf, and `n=0` does not run the least
+/// count that fits in silence.
+#[test]
+fn the_density_studys_settings_are_checked_by_name() {
+    let cases: &[(&str, &str)] = &[
+        ("seeds=0", "seeds must be a whole number ≥ 1, got 0"),
+        ("seeds=1.5", "seeds must be a whole number ≥ 1, got 1.5"),
+        ("rows=0", "rows must be a whole number ≥ 2, got 0"),
+        ("n=0", "n must be a whole number ≥ 1, got 0"),
+        ("n=-5", "n must be a whole number ≥ 1, got -5"),
+        ("periods=x", "periods must be a whole number ≥ 1, got \"x\""),
+        (
+            "densities=0",
+            "each density is a sphere volume fraction above 0 and below 0.5",
+        ),
+        ("densities=0.01,abc", "got \"abc\""),
+    ];
+    for (set, message) in cases {
+        let (ok, out, err) = swimlab(&["run", "scripts/study/densities.rhai", "--set", set]);
+        assert!(!ok, "--set {set} ran:\n{out}");
+        assert!(err.contains(message), "--set {set}:\n{err}");
+        assert!(!out.contains("phi ="), "--set {set} ran a state:\n{out}");
+    }
+}

@@ -371,6 +371,139 @@ fn a_wrong_token_is_404_and_anything_but_get_is_405() {
     assert_ne!(path_of(second.url()), path);
 }
 
+/// Send `bytes` as they are and read the answer until the server closes: its status code (0 for
+/// none).
+fn raw(addr: SocketAddr, bytes: &[u8]) -> u16 {
+    let mut c = TcpStream::connect(addr).unwrap();
+    c.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    c.write_all(bytes).unwrap();
+    let mut text = Vec::new();
+    let _ = c.read_to_end(&mut text);
+    String::from_utf8_lossy(&text)
+        .split_whitespace()
+        .nth(1)
+        .and_then(|w| w.parse().ok())
+        .unwrap_or(0)
+}
+
+/// A broken request line is answered 400 (TLS bytes at once, not after a timeout), a head over
+/// 16 KiB 431, an HTTP version other than 1.0 and 1.1 505, each then closed.
+#[test]
+fn broken_requests_are_answered_400_431_or_505() {
+    let mut sim = Simulation::new(pair(Vector3::zeros()));
+    let server = serve(&mut sim, None);
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    assert_eq!(raw(addr, b"hello there\r\n\r\n"), 400);
+    assert_eq!(raw(addr, b"GET\r\n\r\n"), 400);
+    assert_eq!(
+        raw(addr, format!("GET {path}frame\r\n\r\n").as_bytes()),
+        400
+    );
+    assert_eq!(
+        raw(addr, format!("GET {path}frame HTTP/x\r\n\r\n").as_bytes()),
+        400
+    );
+    let started = Instant::now();
+    assert_eq!(
+        raw(addr, &[0x16, 0x03, 0x01, 0x02, 0x00, 0x01, 0x00, 0x01]),
+        400
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(4),
+        "TLS bytes waited for the head's deadline"
+    );
+    for version in ["HTTP/2.0", "HTTP/0.9", "HTTP/3"] {
+        let head = format!("GET {path}frame {version}\r\nHost: x\r\n\r\n");
+        assert_eq!(raw(addr, head.as_bytes()), 505, "{version}");
+    }
+    let long = format!(
+        "GET {path}frame HTTP/1.1\r\nX-Long: {}\r\n",
+        "a".repeat(17 * 1024)
+    );
+    assert_eq!(raw(addr, long.as_bytes()), 431);
+    let head = format!("GET {path}frame HTTP/1.0\r\n\r\n");
+    assert_eq!(raw(addr, head.as_bytes()), 200);
+}
+
+/// Slow clients cannot lock an honest one out: with 70 connections that trickle their head a
+/// byte at a time and 70 that send nothing, an honest `GET TOKEN/frame` is answered 200, and
+/// the trickling ones are cut off at the head's deadline (5 s for the whole head, however often
+/// they send), well within the loop's bound.
+#[test]
+fn slow_clients_do_not_lock_out_an_honest_one() {
+    let mut sim = Simulation::new(pair(Vector3::zeros()));
+    let server = serve(&mut sim, None);
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    let mut slow: Vec<TcpStream> = (0..70)
+        .map(|_| {
+            let mut c = TcpStream::connect(addr).unwrap();
+            c.write_all(b"G").unwrap();
+            c
+        })
+        .collect();
+    let idle: Vec<TcpStream> = (0..70).map(|_| TcpStream::connect(addr).unwrap()).collect();
+    let (code, _) = request(addr, "GET", &format!("{path}frame"));
+    assert_eq!(code, 200, "an honest client locked out by slow ones");
+    // The slow clients go on sending a byte every 100 ms; by 15 s every one is cut off.
+    let started = Instant::now();
+    let mut open = slow.len();
+    while open > 0 && started.elapsed() < Duration::from_secs(15) {
+        open = 0;
+        for c in &mut slow {
+            if c.write_all(b"E").is_ok() {
+                open += 1;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    for c in &mut slow {
+        c.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        let mut rest = Vec::new();
+        assert!(
+            c.read_to_end(&mut rest).is_ok() || started.elapsed() < Duration::from_secs(20),
+            "a trickling client is still served"
+        );
+    }
+    assert!(
+        started.elapsed() < Duration::from_secs(15),
+        "trickling clients were not cut off at the head's deadline"
+    );
+    drop(idle);
+}
+
+/// Past the bound on connections reading their head (256), a new one cuts off the one that has
+/// waited longest: 270 idle connections do not keep an honest client out either.
+#[test]
+fn idle_connections_past_the_bound_do_not_lock_out_an_honest_one() {
+    let mut sim = Simulation::new(pair(Vector3::zeros()));
+    let server = serve(&mut sim, None);
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    let idle: Vec<TcpStream> = (0..270)
+        .map(|_| TcpStream::connect(addr).unwrap())
+        .collect();
+    let (code, _) = request(addr, "GET", &format!("{path}frame"));
+    assert_eq!(code, 200, "an honest client locked out by idle ones");
+    drop(idle);
+}
+
+/// Many views start and stop without each stop waiting out a poll of its accepting thread
+/// (each waited up to 20 ms): 300 stop well within a generous bound.
+#[test]
+fn many_views_stop_promptly() {
+    let servers: Vec<Server> = (0..300)
+        .map(|_| Server::start(Arc::new(Slot::default()), &ServerOptions::default()).unwrap())
+        .collect();
+    let addrs: Vec<SocketAddr> = servers.iter().map(Server::local_addr).collect();
+    let started = Instant::now();
+    drop(servers);
+    let took = started.elapsed();
+    assert!(
+        took < Duration::from_secs(2),
+        "300 views took {took:?} to stop"
+    );
+    assert!(addrs.iter().all(|a| TcpStream::connect(a).is_err()));
+}
+
 /// Run `source` in-process; the script's variables are returned in its scope, the error as text.
 fn script(source: &str) -> (rhai::Scope<'static>, Result<(), String>) {
     let mut scope = rhai::Scope::new();
@@ -419,6 +552,62 @@ fn a_view_stops_with_its_scene_or_close_view() {
     r.unwrap();
 }
 
+/// A recorder keeps its scene, not the scene's view: replacing or dropping the script's scene
+/// while a recorder of it is held stops the view, as the book says ("nothing is left listening").
+#[test]
+fn a_view_stops_with_its_scene_while_a_recorder_holds_it() {
+    let (scope, r) = script(
+        "let s = scene(); s.add(dumbbell()); let url = s.view(); let rec = s.record([msd()], 1); s.run_periods(1); s = scene(); let rows = rec.len;",
+    );
+    r.unwrap();
+    let url = scope.get_value::<rhai::ImmutableString>("url").unwrap();
+    assert!(
+        TcpStream::connect(addr_of(&url)).is_err(),
+        "the replaced scene's view still listens while its recorder is held"
+    );
+    assert_eq!(scope.get_value::<rhai::INT>("rows"), Some(2));
+    // While the scene lives, the recorder changes nothing: its view serves.
+    let (scope, r) = script(
+        "let s = scene(); s.add(dumbbell()); let url = s.view(); let rec = s.record([msd()], 1); s.run_periods(1);",
+    );
+    r.unwrap();
+    let url = scope.get_value::<rhai::ImmutableString>("url").unwrap();
+    assert_eq!(
+        request(addr_of(&url), "GET", &format!("{}frame", path_of(&url))).0,
+        200
+    );
+}
+
+/// `swimlab run --view` after the script closed its only view says so, not that it started none.
+#[test]
+fn run_with_view_after_close_view_says_the_views_were_stopped() {
+    let dir = cli_dir("close");
+    std::fs::write(
+        dir.join("closed.rhai"),
+        "let s = scene(); s.add(dumbbell()); s.view(); s.close_view();\n",
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_swimlab"))
+        .args(["run", "closed.rhai", "--view"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("every view the script started was stopped before it ended (s.close_view())"),
+        "{err}"
+    );
+    assert!(!err.contains("started no view"), "{err}");
+}
+
+/// A fresh folder for a test that runs the binary.
+fn cli_dir(what: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("swimlab-view-{what}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 #[test]
 fn changes_between_runs_show_at_once() {
     let (scope, r) = script(
@@ -426,12 +615,69 @@ fn changes_between_runs_show_at_once() {
     );
     r.unwrap();
     let url = scope.get_value::<rhai::ImmutableString>("url").unwrap();
-    let (code, body) = request(addr_of(&url), "GET", &format!("{}frame", path_of(&url)));
-    assert_eq!(code, 200);
-    let f: Value = serde_json::from_str(&body).unwrap();
+    // The changes came within a frame's interval of the view's start: the last is drawn when
+    // the next frame is due (1/30 s later), without a run.
+    let started = Instant::now();
+    let f = loop {
+        let (code, body) = request(addr_of(&url), "GET", &format!("{}frame", path_of(&url)));
+        assert_eq!(code, 200);
+        let f: Value = serde_json::from_str(&body).unwrap();
+        if !f["box"].is_null() || started.elapsed() > Duration::from_secs(10) {
+            break f;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
     assert_eq!(f["spheres"].as_array().unwrap().len(), 2, "{f}");
     assert_eq!(f["box"], serde_json::json!([40e-6, 40e-6, 40e-6]));
     assert_eq!(f["t"].as_f64(), Some(0.0));
+}
+
+/// Changes between runs are drawn at the view's rate, not each as it is made: 2,000 swimmers
+/// added one by one with a view open take a few frames (one per 50 ms interval at most, and
+/// fewer as the frames grow), not 2,000; the last change is still drawn, soon after.
+#[test]
+fn changes_between_runs_are_drawn_at_the_views_rate() {
+    let sim = Arc::new(std::sync::RwLock::new(Simulation::new(Scene::new())));
+    let slot = Arc::new(Slot::default());
+    let weak = Arc::downgrade(&sim);
+    let refresh: swimlab::view::Refresh = Arc::new(move || {
+        if let Some(sim) = weak.upgrade() {
+            sim.read().unwrap().show_change();
+        }
+    });
+    let every = Duration::from_millis(50);
+    let publisher =
+        Publisher::new(slot.clone(), Parts::default(), every, None).with_refresh(refresh);
+    sim.write().unwrap().set_watcher(Some(Arc::new(publisher)));
+    let started = Instant::now();
+    for k in 0..2000 {
+        let mut s = sim.write().unwrap();
+        let c = Vector3::new(k as f64 * 20e-6, 0.0, 0.0);
+        s.scene_mut()
+            .add(Dumbbell::default(), c, Vector3::x())
+            .unwrap();
+        s.show_change();
+    }
+    let took = started.elapsed();
+    let frames = slot.published();
+    let most = 2 + (took.as_secs_f64() / every.as_secs_f64()) as u64;
+    assert!(
+        frames <= most,
+        "{frames} frames for 2000 changes in {took:?}"
+    );
+    // The last change is drawn when the next frame is due.
+    let waited = Instant::now();
+    loop {
+        let f: Value = serde_json::from_str(&slot.latest().unwrap()).unwrap();
+        if f["spheres"].as_array().unwrap().len() == 4000 {
+            break;
+        }
+        assert!(
+            waited.elapsed() < Duration::from_secs(10),
+            "the last change was not drawn"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }
 
 #[track_caller]
@@ -487,6 +733,25 @@ fn bad_views_are_clear_messages_and_leave_nothing_listening() {
     refused(
         &format!("{s}s.view(#{{ pace: -1 }});"),
         &["pace is the most stroke periods"],
+    );
+    // A pace that underflows to no time (it ran at full speed) or that would hold a run for
+    // ever: refused with the least pace taken.
+    for (pace, shown) in [
+        ("5e-324", "5e-324"),
+        ("1e-300", "1e-300"),
+        ("2e-5", "0.00002"),
+    ] {
+        refused(
+            &format!("{s}s.view(#{{ pace: {pace} }});"),
+            &[
+                "a number from 1e-4 (a period in under three hours) up",
+                &format!("got {shown}"),
+            ],
+        );
+    }
+    refused(
+        &format!("{s}s.view(#{{ every: 0 }});"),
+        &["above 0 and at most 3600 s"],
     );
     refused(
         &format!("{s}s.view(#{{ fields: [\"sphere\"] }});"),

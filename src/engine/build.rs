@@ -112,6 +112,7 @@ pub fn random_suspension_apart(
     for side in sides {
         require_positive("box side", side, "m")?;
     }
+    scene.check_region_reach(&d, sides)?;
     place_in(scene, n, d, seed, gap, Some(sides), |rng| {
         let u = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5);
         let c = u.component_mul(&Vector3::from(sides));

@@ -121,6 +121,11 @@ impl EngineError {
     /// The message, with each fix shown by `show` (the display uses [`Setting`]'s words; the
     /// script layer shows the script line that makes the setting).
     pub fn message_with(&self, show: &dyn Fn(&Setting) -> String) -> String {
+        compact_numbers(&self.message_in_full(show))
+    }
+
+    /// [`EngineError::message_with`] with its numbers as they were formatted.
+    fn message_in_full(&self, show: &dyn Fn(&Setting) -> String) -> String {
         let fixes = |fixes: &[Setting]| fixes.iter().map(show).collect::<Vec<_>>().join(" or ");
         match self {
             EngineError::Invalid(msg) => msg.clone(),
@@ -210,6 +215,55 @@ pub fn require_finite(name: &str, value: f64) -> Result<()> {
     }
 }
 
+/// The most digits a number in a message is written with in full; a longer one (1e308 as a 1
+/// and 308 zeros, 1e-320 as 320 zeros and a 1) is rewritten by [`compact_numbers`].
+const MAX_DIGITS_IN_FULL: usize = 21;
+
+/// `text` with every decimal number of more than [`MAX_DIGITS_IN_FULL`] digits (Rust's `{}` of
+/// an extreme f64) in scientific form, to the last bit: "got 1e308", not a line of 309 digits.
+/// Shorter numbers, and digits inside words or hex (a token, an address), are left as written.
+pub fn compact_numbers(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut copied = 0;
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts = bytes[i].is_ascii_digit()
+            && (i == 0
+                || !(bytes[i - 1].is_ascii_alphanumeric() || matches!(bytes[i - 1], b'_' | b'.')));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let mut end = i;
+        let mut dot = false;
+        while end < bytes.len() {
+            match bytes[end] {
+                b'0'..=b'9' => end += 1,
+                b'.' if !dot && bytes.get(end + 1).is_some_and(u8::is_ascii_digit) => {
+                    dot = true;
+                    end += 1;
+                }
+                _ => break,
+            }
+        }
+        let glued = bytes
+            .get(end)
+            .is_some_and(|b| b.is_ascii_alphanumeric() || *b == b'_');
+        let digits = end - i - usize::from(dot);
+        if !glued && digits > MAX_DIGITS_IN_FULL {
+            if let Ok(x) = text[i..end].parse::<f64>() {
+                out.push_str(&text[copied..i]);
+                out.push_str(&format!("{x:e}"));
+                copied = end;
+            }
+        }
+        i = end.max(i + 1);
+    }
+    out.push_str(&text[copied..]);
+    out
+}
+
 /// `x` to three significant digits, as a reader of a message takes it in: "75", "7.5e-7".
 pub fn short(x: f64) -> String {
     let r: f64 = format!("{x:.2e}").parse().unwrap_or(x);
@@ -217,5 +271,26 @@ pub fn short(x: f64) -> String {
         format!("{r}")
     } else {
         format!("{r:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::compact_numbers;
+
+    /// Only numbers of more than 21 digits change, to the last bit; digits in hex, in words and
+    /// numbers of ordinary length stay as written.
+    #[test]
+    fn compact_numbers_rewrites_only_the_extreme() {
+        let big = format!("got {}, {} and -{}", 1e308, 5e-324, 1.5e300);
+        assert_eq!(compact_numbers(&big), "got 1e308, 5e-324 and -1.5e300");
+        let plain = "t = 0.0125 s, 12345678901234567890 steps, seed 18446744073709551615";
+        assert_eq!(compact_numbers(plain), plain);
+        let token = format!(
+            "http://127.0.0.1:8/{}a/ x{}",
+            "1".repeat(31),
+            "9".repeat(30)
+        );
+        assert_eq!(compact_numbers(&token), token);
     }
 }

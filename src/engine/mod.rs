@@ -55,7 +55,7 @@ pub mod wall;
 
 pub use backend::Backend;
 pub use contacts::{Contacts, Overlaps, Steric, StericBody, StericLaw};
-pub use error::{EngineError, Result};
+pub use error::{compact_numbers, EngineError, Result};
 pub use integrators::IntegratorSpec;
 pub use mobility::Mobility;
 pub use model::{Coefficients, Model};

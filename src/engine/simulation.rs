@@ -24,6 +24,11 @@ pub trait Watcher: Look {
     /// The watcher was just attached, or a run begins or ends (however it ends): the scene and
     /// the recorders as they are now, worth a look whatever the rate.
     fn settled(&self, scene: &Scene, recorders: &[Recorder]);
+    /// The scene was changed between runs (a swimmer added, a box set): worth a look when one
+    /// is due, since a script may make thousands of changes in a row. By default, a look now.
+    fn changed(&self, scene: &Scene, recorders: &[Recorder]) {
+        self.settled(scene, recorders);
+    }
 }
 
 /// A scene and what runs it. See the [module docs](self).
@@ -130,11 +135,18 @@ impl Simulation {
         self.watcher = w;
     }
 
-    /// Show the watcher, if any, the scene as it is now: after a change between runs (a swimmer
-    /// added, a box set), which a view then draws without waiting for the next run.
+    /// Show the watcher, if any, the scene as it is now, whatever the rate.
     pub fn show_watcher(&self) {
         if let Some(w) = &self.watcher {
             w.settled(&self.scene, &self.recorders);
+        }
+    }
+
+    /// Tell the watcher, if any, that the scene was changed between runs (a swimmer added, a box
+    /// set): a view draws it without waiting for the next run, at its own rate.
+    pub fn show_change(&self) {
+        if let Some(w) = &self.watcher {
+            w.changed(&self.scene, &self.recorders);
         }
     }
 

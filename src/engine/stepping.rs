@@ -128,10 +128,15 @@ impl RunControl {
 
     /// The watch a stepper whose steps hold many inner steps shows the state inside them: a
     /// copy of `s` (made now) takes the inner step's time and state when a look is due.
-    fn inner_watch(&self, s: &Scene) -> Option<StateWatch> {
-        let w = self.watch.clone()?;
-        let shadow = std::sync::Mutex::new(s.clone());
-        Some(Arc::new(move |t: f64, y: &[f64]| {
+    fn inner_watch(&self, s: &Scene, judge: Arc<CollapseJudge>) -> StateWatch {
+        let w = self.watch.clone();
+        let shadow = w.as_ref().map(|_| std::sync::Mutex::new(s.clone()));
+        let control = self.clone();
+        Arc::new(move |t: f64, y: &[f64]| {
+            judge.step(t, &control);
+            let (Some(w), Some(shadow)) = (&w, &shadow) else {
+                return;
+            };
             if w.due() {
                 let mut copy = shadow.lock().unwrap_or_else(|e| e.into_inner());
                 if copy.state.len() == y.len() {
@@ -141,7 +146,7 @@ impl RunControl {
                 }
             }
             w.pace(t);
-        }))
+        })
     }
 
     /// What a watched device run shows its state through between submissions: a copy of `s`
@@ -227,7 +232,56 @@ impl Workspace {
     }
 }
 
-/// Step `s` to `t_end` on the CPU with the guards, taking at most `max_steps` steps.
+/// How long a CPU run goes before it is judged whether its steps have collapsed
+/// ([`Scene::collapsed_steps`]): long enough that the pace is its steady one.
+const COLLAPSE_LOOK: std::time::Duration = std::time::Duration::from_secs(2);
+
+/// Counts a CPU run's steps (a stepper's inner ones where it shows them) and judges once, after
+/// [`COLLAPSE_LOOK`], whether they have collapsed; if so the run's control gives the notice.
+struct CollapseJudge {
+    started: std::time::Instant,
+    from: f64,
+    t_end: f64,
+    period: f64,
+    /// What holds the steps short ([`Scene::collapse_cause`]), taken when the run starts.
+    cause: String,
+    steps: std::sync::atomic::AtomicU64,
+    judged: std::sync::atomic::AtomicBool,
+}
+
+impl CollapseJudge {
+    fn new(s: &Scene, t_end: f64) -> Self {
+        CollapseJudge {
+            started: std::time::Instant::now(),
+            from: s.time,
+            t_end,
+            period: s.shortest_period(),
+            cause: s.collapse_cause(),
+            steps: Default::default(),
+            judged: Default::default(),
+        }
+    }
+
+    /// A step reached scene time `now`.
+    fn step(&self, now: f64, control: &RunControl) {
+        use std::sync::atomic::Ordering;
+        let steps = self.steps.fetch_add(1, Ordering::Relaxed) + 1;
+        if self.judged.load(Ordering::Relaxed) {
+            return;
+        }
+        let wall = self.started.elapsed();
+        if wall < COLLAPSE_LOOK || self.judged.swap(true, Ordering::Relaxed) {
+            return;
+        }
+        let span = (self.from, now, self.t_end);
+        if let Some(note) = Scene::collapsed_steps(self.period, span, steps, wall, &self.cause) {
+            control.notice("collapsed steps", &note);
+        }
+    }
+}
+
+/// Step `s` to `t_end` on the CPU with the guards, taking at most `max_steps` steps; a run whose
+/// steps have collapsed says so after [`COLLAPSE_LOOK`].
 pub fn advance_cpu(
     s: &mut Scene,
     ws: &mut Workspace,
@@ -240,8 +294,9 @@ pub fn advance_cpu(
     let key = s.stepper_key(spec);
     let mut stepper = ws.take_stepper(s, spec, &key)?;
     stepper.set_interrupt(control.interrupt.clone());
+    let judge = Arc::new(CollapseJudge::new(s, t_end));
     if stepper.watches_inside() {
-        stepper.set_watch(control.inner_watch(s));
+        stepper.set_watch(Some(control.inner_watch(s, judge.clone())));
     }
     let mut outcome = Ok(());
     let mut taken = 0;
@@ -257,6 +312,9 @@ pub fn advance_cpu(
                 s.time = t;
                 control.report(s.time);
                 control.look(s);
+                if !stepper.watches_inside() {
+                    judge.step(s.time, control);
+                }
                 if s.stats.direct_fallbacks > fallbacks {
                     if let Some(why) = stepper.report() {
                         control.notice(

@@ -29,7 +29,8 @@ pub type ScriptResult<T> = Result<T, Box<EvalAltResult>>;
 
 /// A runtime error with this message; Rhai fills in the script position of the call.
 pub fn script_error(msg: impl Into<String>) -> Box<EvalAltResult> {
-    EvalAltResult::ErrorRuntime(Dynamic::from(msg.into()), Position::NONE).into()
+    let msg = crate::engine::compact_numbers(&msg.into());
+    EvalAltResult::ErrorRuntime(Dynamic::from(msg), Position::NONE).into()
 }
 
 /// The script line that makes a setting an engine error names as its fix.

@@ -11,6 +11,7 @@ use rhai::{Array, Dynamic, Engine, ImmutableString, Map, INT};
 /// A script's handle on one recorder of a scene.
 #[derive(Debug, Clone)]
 pub struct RecorderHandle {
+    /// Its scene, through a handle that does not keep the scene's live view up.
     pub(super) scene: SceneHandle,
     id: usize,
 }
@@ -200,7 +201,7 @@ pub fn register(engine: &mut Engine) {
                 let trigger = trigger_of(&every)?;
                 let id = lift(s.borrow_mut()?.record(obs, trigger))?;
                 Ok(RecorderHandle {
-                    scene: s.clone(),
+                    scene: s.without_view(),
                     id,
                 })
             },
@@ -217,7 +218,7 @@ pub fn register(engine: &mut Engine) {
                         .trajectory(std::path::Path::new(path.as_str()), trigger),
                 )?;
                 Ok(RecorderHandle {
-                    scene: s.clone(),
+                    scene: s.without_view(),
                     id,
                 })
             },

@@ -87,9 +87,19 @@ struct Uses {
     shadow: Option<Position>,
 }
 
-/// Check the script against the `--set` names: every name read, none shadowed.
+/// Check the script against the `--set` names: each given once, every one read, none shadowed.
 pub fn check(ast: &AST, sets: &Sets) -> Result<(), (Position, String)> {
     use rhai::{ASTNode, Expr, Stmt};
+    for (k, (name, value)) in sets.iter().enumerate() {
+        if let Some((_, first)) = sets[..k].iter().find(|(n, _)| n == name) {
+            return Err((
+                Position::NONE,
+                format!(
+                    "--set {name} is given twice ({name}={first} and {name}={value}); give each name once"
+                ),
+            ));
+        }
+    }
     let names: Vec<&str> = sets.iter().map(|(n, _)| n.as_str()).collect();
     let param_name = |f: &rhai::FnCallExpr| -> Option<String> {
         if f.name != "param" || !f.namespace.is_empty() {

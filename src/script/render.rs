@@ -5,7 +5,7 @@
 //! the fix: the closest known name, or the accepted forms of the call.
 
 use super::convert::suggest;
-use super::signatures::{shown_type, vocabulary};
+use super::signatures::{core_functions, shown_type, vocabulary};
 use rhai::{EvalAltResult, Position};
 
 /// Render a script error against its source text.
@@ -232,7 +232,11 @@ pub(super) fn function_not_found(sig: &str) -> String {
             None => format!("there is no function {call}; check the module alias and the function name"),
         };
     }
-    if let Some(forms) = voc.functions.get(name) {
+    if let Some(forms) = voc
+        .functions
+        .get(name)
+        .or_else(|| core_functions().get(name))
+    {
         return format!(
             "{name} cannot be called as {call}; its forms: {}{}",
             forms.join(", "),

@@ -24,8 +24,25 @@ pub struct SceneHandle {
     sim: Arc<RwLock<Simulation>>,
     /// The sweeps whose calls share this scene now: while any does, it can be read, not changed.
     shared_by_sweeps: SweepCount,
-    /// The live view of this scene, if one is served (`s.view()`): it stops with the last handle.
+    /// The live view of this scene, if one is served (`s.view()`).
     view: Arc<Mutex<Option<Arc<Server>>>>,
+    /// Held by the handles that are the script's scene values (not by a recorder's handle): the
+    /// view stops when the last of them is dropped, though recorders keep the scene.
+    _owner: Option<Arc<ViewOwner>>,
+}
+
+/// Stops a scene's live view when dropped (see [`SceneHandle`]'s `_owner`).
+#[derive(Debug)]
+struct ViewOwner {
+    view: Arc<Mutex<Option<Arc<Server>>>>,
+}
+
+impl Drop for ViewOwner {
+    fn drop(&mut self) {
+        let server = self.view.lock().unwrap_or_else(|e| e.into_inner()).take();
+        // Outside the lock: dropping the last handle on a server joins its threads.
+        drop(server);
+    }
 }
 
 /// How many sweeps' calls share a script value now (a scene, a continuum): they run at once on
@@ -82,16 +99,38 @@ impl SceneHandle {
         sim.set_notice(Some(Arc::new(|e: &crate::engine::EngineError| {
             super::console::note(&super::engine_message(e))
         })));
+        let view = Arc::<Mutex<Option<Arc<Server>>>>::default();
         SceneHandle {
             sim: Arc::new(RwLock::new(sim)),
             shared_by_sweeps: SweepCount::default(),
-            view: Arc::default(),
+            _owner: Some(Arc::new(ViewOwner { view: view.clone() })),
+            view,
+        }
+    }
+
+    /// A handle on the same scene that does not keep its live view up (a recorder's): the view
+    /// stops with the script's last scene value even while this handle lives.
+    pub(super) fn without_view(&self) -> SceneHandle {
+        SceneHandle {
+            _owner: None,
+            ..self.clone()
         }
     }
 
     /// Whether `other` is a handle on the same scene.
     pub(super) fn same(&self, other: &SceneHandle) -> bool {
         Arc::ptr_eq(&self.sim, &other.sim)
+    }
+
+    /// Shows the scene's watcher (its live view) the scene as it is as a change, from any
+    /// thread, while the scene lives: the view's late drawing of a change, at the view's rate.
+    pub(super) fn redraw(&self) -> crate::view::Refresh {
+        let sim = Arc::downgrade(&self.sim);
+        Arc::new(move || {
+            if let Some(sim) = sim.upgrade() {
+                sim.read().unwrap_or_else(|e| e.into_inner()).show_change();
+            }
+        })
     }
 
     /// The scene's live view, if one is served.
@@ -143,7 +182,7 @@ impl SceneHandle {
     ) -> ScriptResult<T> {
         let mut sim = self.borrow_mut()?;
         let result = f(sim.scene_mut());
-        sim.show_watcher();
+        sim.show_change();
         lift(result)
     }
 
@@ -159,7 +198,7 @@ impl SceneHandle {
     pub(super) fn replace(&self, trial: Scene) -> ScriptResult<INT> {
         let mut sim = self.borrow_mut()?;
         sim.replace_scene(trial);
-        sim.show_watcher();
+        sim.show_change();
         Ok(sim.count() as INT)
     }
 }

@@ -68,16 +68,7 @@ pub fn install(engine: &rhai::Engine) {
             let Some(name) = f["name"].as_str() else {
                 continue;
             };
-            let params: Vec<String> = f["params"]
-                .as_array()
-                .map(|ps| {
-                    ps.iter()
-                        .filter_map(|p| p["type"].as_str())
-                        .filter(|t| !t.contains("NativeCallContext"))
-                        .map(script_type)
-                        .collect()
-                })
-                .unwrap_or_default();
+            let params = params_of(&f);
             if let Some(prop) = name.strip_prefix("get$") {
                 let ty = params.first().cloned().unwrap_or_default();
                 v.getters.entry(ty).or_default().push(prop.to_string());
@@ -107,6 +98,58 @@ pub fn install(engine: &rhai::Engine) {
         }
         v
     });
+}
+
+/// The parameter types of a function of Rhai's metadata, as a script user knows them.
+fn params_of(f: &serde_json::Value) -> Vec<String> {
+    f["params"]
+        .as_array()
+        .map(|ps| {
+            ps.iter()
+                // A parameter of no stated type takes anything.
+                .map(|p| p["type"].as_str().unwrap_or("Dynamic"))
+                .filter(|t| !t.contains("NativeCallContext"))
+                .map(script_type)
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Rhai's own functions (its standard packages: `split`, `trim`, `push`, ...), name → call
+/// forms such as "split(string, string)", read once from a plain engine's metadata: a wrong call
+/// of one is answered with its forms, as a wrong call of a swimlab function is.
+pub fn core_functions() -> &'static BTreeMap<String, Vec<String>> {
+    static CORE: OnceLock<BTreeMap<String, Vec<String>>> = OnceLock::new();
+    CORE.get_or_init(|| {
+        let json = rhai::Engine::new()
+            .gen_fn_metadata_to_json(true)
+            .unwrap_or_default();
+        let parsed: serde_json::Value = serde_json::from_str(&json).unwrap_or_default();
+        let mut out: BTreeMap<String, Vec<String>> = BTreeMap::new();
+        for f in parsed["functions"].as_array().into_iter().flatten() {
+            let Some(name) = f["name"].as_str() else {
+                continue;
+            };
+            if name.contains('$') || name == "to_debug" {
+                continue;
+            }
+            let form = format!("{name}({})", params_of(f).join(", "));
+            let forms = out.entry(name.to_string()).or_default();
+            if !forms.contains(&form) {
+                forms.push(form);
+            }
+        }
+        // The metadata's order is a hash map's: shortest forms first, then by name.
+        for forms in out.values_mut() {
+            forms.sort_by_key(|f| {
+                (
+                    f.matches(", ").count() + usize::from(!f.ends_with("()")),
+                    f.clone(),
+                )
+            });
+        }
+        out
+    })
 }
 
 /// A Rhai type name in a "Function not found" signature as a script user knows it.

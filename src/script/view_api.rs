@@ -11,6 +11,7 @@ use super::scene_api::SceneHandle;
 use crate::view::{Pace, Parts, Publisher, Server, ServerOptions, Slot};
 use rhai::{Dynamic, Engine, ImmutableString, Map};
 use std::net::IpAddr;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::time::Duration;
 
@@ -19,6 +20,10 @@ const KEYS: &[&str] = &["port", "every", "pace", "fields", "address", "expose"];
 
 /// The least time between two frames by default: 30 frames a second.
 const DEFAULT_EVERY: f64 = 1.0 / 30.0;
+
+/// The slowest pace a view holds runs to (periods per wall-clock second): slower, a period
+/// would take days, and far slower the pace's arithmetic underflows to none at all.
+const MIN_PACE: f64 = 1e-4;
 
 /// A front end's own way to show a view's page (the kernel's inline frame): called with its
 /// address when a view starts.
@@ -33,6 +38,9 @@ pub fn set_sink(sink: Option<ViewSink>) {
 
 /// Every view started in this process, while it serves.
 static STARTED: Mutex<Vec<Weak<Server>>> = Mutex::new(Vec::new());
+
+/// Whether this process ever started a view (to tell "none started" from "all stopped").
+static ANY_STARTED: AtomicBool = AtomicBool::new(false);
 
 /// The views kept past their scenes (`Some` once [`keep_views`] was called).
 static KEPT: Mutex<Option<Vec<Arc<Server>>>> = Mutex::new(None);
@@ -52,7 +60,11 @@ pub fn keep_views() {
 pub fn serve_until_interrupted() {
     let urls = live_views();
     if urls.is_empty() {
-        console::note("--view: the script started no view (s.view()), so there is none to keep up");
+        console::note(if !ANY_STARTED.load(Ordering::SeqCst) {
+            "--view: the script started no view (s.view()), so there is none to keep up"
+        } else {
+            "--view: every view the script started was stopped before it ended (s.close_view()), so there is none to keep up; leave out s.close_view() to keep a page up after the script"
+        });
         return;
     }
     console::note(&format!(
@@ -164,16 +176,16 @@ impl Options {
             let every = number("view: every", v)?;
             if !(every > 0.0 && every <= 3600.0) {
                 return Err(script_error(format!(
-                    "view: every is the least wall-clock time between frames, from 0 to 3600 s (default {DEFAULT_EVERY:.4} s: 30 frames a second), got {every}"
+                    "view: every is the least wall-clock time between frames, above 0 and at most 3600 s (default {DEFAULT_EVERY:.4} s: 30 frames a second), got {every}"
                 )));
             }
             o.every = Duration::from_secs_f64(every);
         }
         if let Some(v) = opts.get("pace") {
             let pace = number("view: pace", v)?;
-            if !(pace > 0.0 && pace.is_finite()) {
+            if !(pace >= MIN_PACE && pace.is_finite()) {
                 return Err(script_error(format!(
-                    "view: pace is the most stroke periods a run goes per second of wall-clock time, a number > 0 (leave it out to run at full speed), got {pace}"
+                    "view: pace is the most stroke periods a run goes per second of wall-clock time, a number from {MIN_PACE:e} (a period in under three hours) up (leave it out to run at full speed), got {pace}"
                 )));
             }
             o.pace = Some(pace);
@@ -238,16 +250,23 @@ fn view(s: &mut SceneHandle, opts: &Map) -> ScriptResult<ImmutableString> {
                     super::engine_message(&e)
                 ))
             })?;
+            let seconds_per_second = periods * period;
+            if seconds_per_second <= 0.0 {
+                return Err(script_error(format!(
+                    "view: pace {periods} periods a second of a stroke period of {period} s is no time at all in f64; give a larger pace, or leave pace out to run at full speed"
+                )));
+            }
             let stop = interrupt::current();
             Some(Pace {
-                seconds_per_second: periods * period,
+                seconds_per_second,
                 stop: Arc::new(move || stop.requested()),
             })
         }
     };
     let slot = Arc::new(Slot::default());
     let server = Server::start(slot.clone(), &o.server).map_err(|e| bind_error(&e, &o.server))?;
-    sim.set_watcher(Some(Arc::new(Publisher::new(slot, o.parts, o.every, pace))));
+    let publisher = Publisher::new(slot, o.parts, o.every, pace).with_refresh(s.redraw());
+    sim.set_watcher(Some(Arc::new(publisher)));
     drop(sim);
     let server = Arc::new(server);
     let url = server.url().to_string();
@@ -258,6 +277,7 @@ fn view(s: &mut SceneHandle, opts: &Map) -> ScriptResult<ImmutableString> {
         ));
     }
     lock(&STARTED).push(Arc::downgrade(&server));
+    ANY_STARTED.store(true, Ordering::SeqCst);
     if let Some(kept) = lock(&KEPT).as_mut() {
         kept.push(server.clone());
     }

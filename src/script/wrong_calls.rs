@@ -6,36 +6,56 @@
 //! (`#{"error": "ErrorFunctionNotFound", "function": "add_at (Scene, Dumbbell, &str |
 //! ImmutableString | String)", ...}`).
 //!
-//! Each swimlab function name gets, for every arity up to two more than its longest form, a form
-//! whose parameters are all `Dynamic`. Rhai tries such forms only after every form of the exact
-//! argument types (in every module, Rhai's standard library included), so they answer only calls
-//! that would otherwise not be found. Names Rhai's standard library also defines are left to it,
-//! and so are operators, property accessors and indexers (their errors are Rhai's, rendered by
-//! the error renderer where uncaught).
+//! Each swimlab function name, and each of Rhai's own (`split`, `trim`, ...), gets for every
+//! arity up to two more than its longest form a form whose parameters are all `Dynamic`. Rhai
+//! tries such forms only after every form of the exact argument types (in every module, Rhai's
+//! standard library included), so they answer only calls that would otherwise not be found.
+//! Arities where a form already takes anything are left alone, and so are the functions Rhai
+//! itself calls and treats a missing form of specially (printing, `type_of`, function pointers),
+//! operators, property accessors and indexers (their errors are Rhai's, rendered by the error
+//! renderer where uncaught). A name both define keeps its swimlab forms' message.
 
 use rhai::{Dynamic, Engine, EvalAltResult, NativeCallContext, Position};
 use std::any::TypeId;
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::OnceLock;
 
-/// Per swimlab function name, the arities that get the all-`Dynamic` form.
+/// Functions that Rhai calls itself, or whose missing form it treats as an answer (printing a
+/// value without `to_string`, `type_of`, function pointers and their calls, `eval`).
+const RHAI_OWN: &[&str] = &[
+    "to_string",
+    "print",
+    "debug",
+    "type_of",
+    "Fn",
+    "call",
+    "curry",
+    "eval",
+    "is_def_fn",
+    "is_def_var",
+    "is_shared",
+];
+
+/// Per function name, the arities that get the all-`Dynamic` form.
 pub(super) fn arities() -> &'static BTreeMap<String, Vec<usize>> {
     static A: OnceLock<BTreeMap<String, Vec<usize>>> = OnceLock::new();
     A.get_or_init(|| {
-        let rhai_names: BTreeSet<String> = Engine::new()
-            .gen_fn_signatures(true)
-            .iter()
-            .filter_map(|sig| sig.split('(').next())
-            .map(|n| n.trim().to_string())
-            .collect();
+        let core = super::signatures::core_functions();
+        let swimlab = &super::signatures::vocabulary().functions;
+        // A name both define: every form either has, so that none of the answering forms
+        // stands where one of Rhai's takes anything.
+        let mut all: BTreeMap<&String, Vec<&String>> = BTreeMap::new();
+        for (name, forms) in swimlab.iter().chain(core) {
+            all.entry(name).or_default().extend(forms);
+        }
         let mut out = BTreeMap::new();
-        for (name, forms) in &super::signatures::vocabulary().functions {
+        for (name, forms) in all {
             let is_ident = name
                 .chars()
                 .next()
                 .is_some_and(|c| c.is_alphabetic() || c == '_')
                 && name.chars().all(|c| c.is_alphanumeric() || c == '_');
-            if !is_ident || rhai_names.contains(name) || name == "to_string" {
+            if !is_ident || RHAI_OWN.contains(&name.as_str()) {
                 continue;
             }
             let params = |form: &str| -> Vec<String> {

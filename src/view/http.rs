@@ -1,8 +1,10 @@
-//! The little HTTP/1.1 a view speaks: a request's first line and headers read with a size bound,
-//! and whole responses written with `Connection: close` (one request per connection).
+//! The little HTTP/1.1 a view speaks: a request's first line and headers read with a size bound
+//! and one deadline for the whole head, and whole responses written with `Connection: close`
+//! (one request per connection).
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
+use std::time::Instant;
 
 /// The longest request head read (request line and headers).
 const MAX_HEAD: usize = 16 * 1024;
@@ -13,30 +15,105 @@ pub struct Request {
     pub path: String,
 }
 
-/// Read a request head from `stream`; `None` if the client sent none (closed, timed out, too
-/// long or not HTTP).
-pub fn read_request(stream: &mut TcpStream) -> Option<Request> {
+/// Why no request was read, and the answer it gets (`None`: the connection is closed unanswered).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refusal {
+    /// Closed, failed or past the deadline before a whole head came: no answer.
+    Gone,
+    /// Not an HTTP request line (TLS bytes, a line of other words, not text): 400.
+    Malformed,
+    /// A head longer than [`MAX_HEAD`]: 431.
+    TooLarge,
+    /// An HTTP version other than 1.0 and 1.1: 505.
+    Version,
+}
+
+impl Refusal {
+    /// The status line and body this refusal is answered with, if any.
+    pub fn answer(self) -> Option<(&'static str, &'static [u8])> {
+        match self {
+            Refusal::Gone => None,
+            Refusal::Malformed => Some(("400 Bad Request", b"not an HTTP/1.1 request\n")),
+            Refusal::TooLarge => Some((
+                "431 Request Header Fields Too Large",
+                b"the request head is over 16 KiB\n",
+            )),
+            Refusal::Version => Some((
+                "505 HTTP Version Not Supported",
+                b"only HTTP/1.0 and HTTP/1.1 are served\n",
+            )),
+        }
+    }
+}
+
+/// Whether `b` may begin a method (a token of capital letters, as every HTTP method is).
+fn method_byte(b: u8) -> bool {
+    b.is_ascii_uppercase()
+}
+
+/// The request line `line` (without its line end) read: method, target, whether the version is
+/// served.
+fn request_line(line: &[u8]) -> Result<Request, Refusal> {
+    let line = std::str::from_utf8(line).map_err(|_| Refusal::Malformed)?;
+    let words: Vec<&str> = line.split(' ').collect();
+    let [method, target, version] = words[..] else {
+        return Err(Refusal::Malformed);
+    };
+    if method.is_empty() || !method.bytes().all(method_byte) || !target.starts_with('/') {
+        return Err(Refusal::Malformed);
+    }
+    let v = version.strip_prefix("HTTP/").ok_or(Refusal::Malformed)?;
+    let numbered = v
+        .split('.')
+        .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()));
+    if !numbered {
+        return Err(Refusal::Malformed);
+    }
+    if v != "1.0" && v != "1.1" {
+        return Err(Refusal::Version);
+    }
+    let path = target.split(['?', '#']).next().unwrap_or("").to_string();
+    Ok(Request {
+        method: method.to_string(),
+        path,
+    })
+}
+
+/// Read a request head from `stream`, all of it by `deadline` (a client that trickles its head
+/// byte by byte is cut off there, however often it sends). A request line that cannot be HTTP
+/// is refused as soon as its first byte or its whole line has come.
+pub fn read_request(stream: &mut TcpStream, deadline: Instant) -> Result<Request, Refusal> {
     let mut head = Vec::with_capacity(1024);
     let mut buf = [0u8; 1024];
-    while !head.windows(4).any(|w| w == b"\r\n\r\n") && !head.windows(2).any(|w| w == b"\n\n") {
-        if head.len() > MAX_HEAD {
-            return None;
+    let mut line: Option<Request> = None;
+    loop {
+        if let Some(end) = head.iter().position(|&b| b == b'\n') {
+            if line.is_none() {
+                let first = &head[..end];
+                line = Some(request_line(first.strip_suffix(b"\r").unwrap_or(first))?);
+            }
+            if head.windows(4).any(|w| w == b"\r\n\r\n") || head.windows(2).any(|w| w == b"\n\n") {
+                return line.ok_or(Refusal::Malformed);
+            }
+        } else if head.first().is_some_and(|&b| !method_byte(b)) {
+            return Err(Refusal::Malformed);
         }
-        let n = stream.read(&mut buf).ok()?;
+        if head.len() > MAX_HEAD {
+            return Err(Refusal::TooLarge);
+        }
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(Refusal::Gone);
+        }
+        stream
+            .set_read_timeout(Some(left))
+            .map_err(|_| Refusal::Gone)?;
+        let n = stream.read(&mut buf).map_err(|_| Refusal::Gone)?;
         if n == 0 {
-            return None;
+            return Err(Refusal::Gone);
         }
         head.extend_from_slice(&buf[..n]);
     }
-    let head = String::from_utf8_lossy(&head);
-    let mut words = head.lines().next()?.split_whitespace();
-    let method = words.next()?.to_string();
-    let target = words.next()?;
-    if !words.next()?.starts_with("HTTP/1.") {
-        return None;
-    }
-    let path = target.split(['?', '#']).next().unwrap_or("").to_string();
-    Some(Request { method, path })
 }
 
 /// Write a whole response: `status` (e.g. "200 OK"), its content type and body.

@@ -15,6 +15,6 @@ mod server;
 mod slot;
 
 pub use frame::{Parts, RowSnapshot};
-pub use publisher::{Pace, Publisher};
+pub use publisher::{Pace, Publisher, Refresh};
 pub use server::{Server, ServerOptions};
 pub use slot::Slot;

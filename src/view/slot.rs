@@ -76,6 +76,11 @@ impl Slot {
         }
     }
 
+    /// Whether the slot was closed (its server stopped).
+    pub fn is_closed(&self) -> bool {
+        self.lock().closed
+    }
+
     /// Wake every reader and tell it no frame will come.
     pub fn close(&self) {
         self.lock().closed = true;

@@ -5,6 +5,7 @@
 //! (`integrators::policy`); and the cost notices a run gives when it starts.
 
 use super::*;
+use crate::engine::error::short;
 use crate::engine::integrators::{
     auto_choice, check_noise, Facts, Stepper, Stroboscopic, Suspension,
 };
@@ -55,7 +56,27 @@ impl Scene {
     /// before a smaller one came) is refused here, where every run and rate starts.
     pub fn system(&self) -> Result<Box<dyn OdeSystem>> {
         self.check_boundary_reach()?;
+        self.check_steric_range()?;
         self.swimmer_model().system(self)
+    }
+
+    /// In a box the steric range is at most half its shortest side, as the averaged model's
+    /// cutoff is: beyond, every pair is within the range through some minimum image, all repel
+    /// at once and the steps shrink to the step-size floor.
+    fn check_steric_range(&self) -> Result<()> {
+        let (Some(b), Some(st)) = (self.periodic(), self.contacts.steric) else {
+            return Ok(());
+        };
+        let half = 0.5 * b.shortest();
+        if st.range > half {
+            return Err(invalid!(
+                "the steric range {} m is longer than half the box's shortest side ({} m): every pair would repel through a minimum image; set a range up to {} m (a small fraction of a sphere radius is usual, such as 1e-7 m), or use a larger box",
+                short(st.range),
+                short(half),
+                short(half)
+            ));
+        }
+        Ok(())
     }
 
     /// What makes the next run far costlier than its length suggests, each as a notice of its

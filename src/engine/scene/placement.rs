@@ -47,6 +47,30 @@ fn overlap_error(s: usize, gap: f64) -> EngineError {
 }
 
 impl Scene {
+    /// A region of sides `sides` (m, a cuboid centred on the origin) that copies of `d` are to
+    /// be drawn in lies within the reach of positions ([`MAX_EXTENT_IN_RADII`]) of this scene's
+    /// swimmers and `d`.
+    pub(in crate::engine) fn check_region_reach(
+        &self,
+        d: &Dumbbell,
+        sides: [f64; 3],
+    ) -> Result<()> {
+        let Some(extent) = Extent::of(self.swimmers.iter().chain([d])) else {
+            return Ok(());
+        };
+        let half = 0.5 * sides.iter().copied().fold(0.0, f64::max);
+        if half > extent.limit {
+            return Err(invalid!(
+                "swimmers drawn at random in a cube of side {} m would lie up to {} m from the origin, beyond the {} m that positions may reach ({MAX_EXTENT_IN_RADII:e} times the smallest sphere radius, {} m: there f64 no longer resolves the spheres); give a larger volume fraction (the side is (n v / volume fraction)^(1/3)), or fewer swimmers",
+                short(2.0 * half),
+                short(half),
+                short(extent.limit),
+                short(extent.radius)
+            ));
+        }
+        Ok(())
+    }
+
     /// Whether swimmer `d` can be placed in this scene at all: valid, and in a box short of
     /// meeting its own image.
     pub(in crate::engine) fn check_placeable(&self, d: &Dumbbell) -> Result<()> {
