@@ -386,6 +386,10 @@ fn raw(addr: SocketAddr, bytes: &[u8]) -> u16 {
         .unwrap_or(0)
 }
 
+/// The tests that hold hundreds of sockets run one at a time, so that two of them together stay
+/// within a soft limit of 1,024 open files.
+static FEW_SOCKETS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// A broken request line is answered 400 (TLS bytes at once, not after a timeout), a head over
 /// 16 KiB 431, an HTTP version other than 1.0 and 1.1 505, each then closed.
 #[test]
@@ -416,6 +420,22 @@ fn broken_requests_are_answered_400_431_or_505() {
         let head = format!("GET {path}frame {version}\r\nHost: x\r\n\r\n");
         assert_eq!(raw(addr, head.as_bytes()), 505, "{version}");
     }
+    assert_eq!(raw(addr, b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n"), 505);
+    // A refused client that goes on trickling bytes is closed within the linger's bound (well
+    // under a second), not read for as long as it sends.
+    let mut c = TcpStream::connect(addr).unwrap();
+    c.write_all(b"hello there\r\n\r\n").unwrap();
+    let started = Instant::now();
+    let mut closed = false;
+    while !closed && started.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(100));
+        closed = c.write_all(b"x").is_err();
+    }
+    assert!(
+        closed && started.elapsed() < Duration::from_secs(5),
+        "a refused client trickling bytes was still read after {:?}",
+        started.elapsed()
+    );
     let long = format!(
         "GET {path}frame HTTP/1.1\r\nX-Long: {}\r\n",
         "a".repeat(17 * 1024)
@@ -431,6 +451,7 @@ fn broken_requests_are_answered_400_431_or_505() {
 /// they send), well within the loop's bound.
 #[test]
 fn slow_clients_do_not_lock_out_an_honest_one() {
+    let _few = FEW_SOCKETS.lock().unwrap_or_else(|e| e.into_inner());
     let mut sim = Simulation::new(pair(Vector3::zeros()));
     let server = serve(&mut sim, None);
     let (addr, path) = (server.local_addr(), path_of(server.url()));
@@ -456,14 +477,6 @@ fn slow_clients_do_not_lock_out_an_honest_one() {
         }
         std::thread::sleep(Duration::from_millis(100));
     }
-    for c in &mut slow {
-        c.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-        let mut rest = Vec::new();
-        assert!(
-            c.read_to_end(&mut rest).is_ok() || started.elapsed() < Duration::from_secs(20),
-            "a trickling client is still served"
-        );
-    }
     assert!(
         started.elapsed() < Duration::from_secs(15),
         "trickling clients were not cut off at the head's deadline"
@@ -472,13 +485,14 @@ fn slow_clients_do_not_lock_out_an_honest_one() {
 }
 
 /// Past the bound on connections reading their head (256), a new one cuts off the one that has
-/// waited longest: 270 idle connections do not keep an honest client out either.
+/// waited longest: 260 idle connections do not keep an honest client out either.
 #[test]
 fn idle_connections_past_the_bound_do_not_lock_out_an_honest_one() {
+    let _few = FEW_SOCKETS.lock().unwrap_or_else(|e| e.into_inner());
     let mut sim = Simulation::new(pair(Vector3::zeros()));
     let server = serve(&mut sim, None);
     let (addr, path) = (server.local_addr(), path_of(server.url()));
-    let idle: Vec<TcpStream> = (0..270)
+    let idle: Vec<TcpStream> = (0..260)
         .map(|_| TcpStream::connect(addr).unwrap())
         .collect();
     let (code, _) = request(addr, "GET", &format!("{path}frame"));
@@ -486,20 +500,24 @@ fn idle_connections_past_the_bound_do_not_lock_out_an_honest_one() {
     drop(idle);
 }
 
-/// Many views start and stop without each stop waiting out a poll of its accepting thread
-/// (each waited up to 20 ms): 300 stop well within a generous bound.
+/// Many views stop without each stop waiting out a poll of its accepting thread: stopping 300
+/// takes at most three times what starting them took, and a second (a poll of 20 ms a view
+/// would take 6 s), a bound that scales with the machine's load.
 #[test]
 fn many_views_stop_promptly() {
+    let _few = FEW_SOCKETS.lock().unwrap_or_else(|e| e.into_inner());
+    let started = Instant::now();
     let servers: Vec<Server> = (0..300)
         .map(|_| Server::start(Arc::new(Slot::default()), &ServerOptions::default()).unwrap())
         .collect();
+    let start = started.elapsed();
     let addrs: Vec<SocketAddr> = servers.iter().map(Server::local_addr).collect();
     let started = Instant::now();
     drop(servers);
     let took = started.elapsed();
     assert!(
-        took < Duration::from_secs(2),
-        "300 views took {took:?} to stop"
+        took < 3 * start + Duration::from_secs(1),
+        "300 views took {took:?} to stop, {start:?} to start"
     );
     assert!(addrs.iter().all(|a| TcpStream::connect(a).is_err()));
 }
@@ -609,7 +627,7 @@ fn cli_dir(what: &str) -> PathBuf {
 }
 
 #[test]
-fn changes_between_runs_show_at_once() {
+fn changes_between_runs_show_without_a_run() {
     let (scope, r) = script(
         "let s = scene(); let url = s.view(); s.add(dumbbell()); s.box = [40e-6, 40e-6, 40e-6];",
     );
@@ -734,8 +752,8 @@ fn bad_views_are_clear_messages_and_leave_nothing_listening() {
         &format!("{s}s.view(#{{ pace: -1 }});"),
         &["pace is the most stroke periods"],
     );
-    // A pace that underflows to no time (it ran at full speed) or that would hold a run for
-    // ever: refused with the least pace taken.
+    // A pace whose period underflows to no time between frames, or one that would hold a run
+    // for ever: refused with the least pace taken.
     for (pace, shown) in [
         ("5e-324", "5e-324"),
         ("1e-300", "1e-300"),

@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 mod boundary;
 mod dynamics;
 mod external;
+pub(crate) use external::CollapseCause;
 mod placement;
 mod save;
 mod settings;

@@ -194,7 +194,7 @@ impl Simulation {
         }
         let t_end = self.scene.time() + duration;
         self.check_run(t_end)?;
-        self.control.begin_run();
+        self.control.begin_run_to(t_end);
         if t_end > self.scene.time() {
             for (kind, note) in self.scene.cost_notices() {
                 self.control.notice(kind, &note);

@@ -48,6 +48,15 @@ pub struct RunControl {
     watch: Option<Arc<dyn Look>>,
     /// The kinds of notice given since the run began.
     noticed: Arc<std::sync::Mutex<Vec<&'static str>>>,
+    /// The run under way, shared by its segments.
+    run: Arc<std::sync::Mutex<RunUnderWay>>,
+}
+
+/// What a run's segments share: its end (s), once said, and its collapse judge, once made.
+#[derive(Default)]
+struct RunUnderWay {
+    end: Option<f64>,
+    judge: Option<Arc<CollapseJudge>>,
 }
 
 impl std::fmt::Debug for RunControl {
@@ -87,6 +96,28 @@ impl RunControl {
         if let Ok(mut k) = self.noticed.lock() {
             k.clear();
         }
+        if let Ok(mut r) = self.run.lock() {
+            *r = RunUnderWay::default();
+        }
+    }
+
+    /// A run to scene time `t_end` begins (its segments, between recorder rows, one run): every
+    /// kind of notice may be given again, and its steps are judged once across its segments.
+    pub fn begin_run_to(&self, t_end: f64) {
+        self.begin_run();
+        if let Ok(mut r) = self.run.lock() {
+            r.end = Some(t_end);
+        }
+    }
+
+    /// The collapse judge of the run under way, made at its first segment from `s` (to the
+    /// run's end, else `t_end`).
+    fn collapse_judge(&self, s: &Scene, t_end: f64) -> Arc<CollapseJudge> {
+        let mut r = self.run.lock().unwrap_or_else(|e| e.into_inner());
+        let end = r.end.unwrap_or(t_end);
+        r.judge
+            .get_or_insert_with(|| Arc::new(CollapseJudge::new(s, end)))
+            .clone()
     }
 
     /// Give the notice `e` of kind `kind`, unless one of that kind was given in this run.
@@ -174,6 +205,7 @@ impl RunControl {
             notice: None,
             watch: None,
             noticed: Arc::default(),
+            run: Arc::default(),
         }
     }
 }
@@ -243,8 +275,8 @@ struct CollapseJudge {
     from: f64,
     t_end: f64,
     period: f64,
-    /// What holds the steps short ([`Scene::collapse_cause`]), taken when the run starts.
-    cause: String,
+    /// What may hold the steps short ([`Scene::collapse_cause`]), taken when the run starts.
+    cause: crate::engine::scene::CollapseCause,
     steps: std::sync::atomic::AtomicU64,
     judged: std::sync::atomic::AtomicBool,
 }
@@ -294,7 +326,13 @@ pub fn advance_cpu(
     let key = s.stepper_key(spec);
     let mut stepper = ws.take_stepper(s, spec, &key)?;
     stepper.set_interrupt(control.interrupt.clone());
-    let judge = Arc::new(CollapseJudge::new(s, t_end));
+    // A fixed step is the user's choice, not a collapse.
+    let judge = control.collapse_judge(s, t_end);
+    if spec.fixed_step().is_some() {
+        judge
+            .judged
+            .store(true, std::sync::atomic::Ordering::Relaxed);
+    }
     if stepper.watches_inside() {
         stepper.set_watch(Some(control.inner_watch(s, judge.clone())));
     }

@@ -59,9 +59,10 @@ fn request_line(line: &[u8]) -> Result<Request, Refusal> {
     let [method, target, version] = words[..] else {
         return Err(Refusal::Malformed);
     };
-    if method.is_empty() || !method.bytes().all(method_byte) || !target.starts_with('/') {
+    if method.is_empty() || !method.bytes().all(method_byte) {
         return Err(Refusal::Malformed);
     }
+    // The version before the target: HTTP/2's preface, `PRI * HTTP/2.0`, is a version refused.
     let v = version.strip_prefix("HTTP/").ok_or(Refusal::Malformed)?;
     let numbered = v
         .split('.')
@@ -71,6 +72,9 @@ fn request_line(line: &[u8]) -> Result<Request, Refusal> {
     }
     if v != "1.0" && v != "1.1" {
         return Err(Refusal::Version);
+    }
+    if !target.starts_with('/') {
+        return Err(Refusal::Malformed);
     }
     let path = target.split(['?', '#']).next().unwrap_or("").to_string();
     Ok(Request {

@@ -282,21 +282,29 @@ fn serve(mut stream: TcpStream, shared: &Shared, reading: &AtomicBool, deadline:
 }
 
 /// After answering a request whose rest was not read: say no more will be written, and read
-/// (a bounded amount, briefly) what the client still sends, so that closing with unread bytes
-/// does not reset the connection before the client has read the answer.
+/// what the client still sends, a bounded amount until [`LINGER`] has passed in all, so that
+/// closing with unread bytes does not reset the connection before the client has read the
+/// answer (and a client that trickles bytes holds the thread no longer).
 fn linger(stream: &mut TcpStream) {
     use std::io::Read;
     let _ = stream.shutdown(std::net::Shutdown::Write);
-    let _ = stream.set_read_timeout(Some(Duration::from_millis(200)));
+    let end = Instant::now() + LINGER;
     let mut buf = [0u8; 4096];
     let mut left: usize = 64 * 1024;
     while left > 0 {
+        let now = Instant::now();
+        if now >= end || stream.set_read_timeout(Some(end - now)).is_err() {
+            return;
+        }
         match stream.read(&mut buf) {
             Ok(n) if n > 0 => left = left.saturating_sub(n),
             _ => return,
         }
     }
 }
+
+/// How long a refused connection is read after its answer, in all.
+const LINGER: Duration = Duration::from_millis(300);
 
 fn answer(stream: &mut TcpStream, shared: &Shared, Request { method, path }: Request) {
     // The first segment is the token: `/TOKEN`, `/TOKEN/`, `/TOKEN/frame`.

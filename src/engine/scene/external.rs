@@ -53,19 +53,24 @@ impl Scene {
             .max_by(|p, q| (p.1 * p.2).total_cmp(&(q.1 * q.2)))
     }
 
-    /// What holds a collapsed run's steps short ([`Scene::collapsed_steps`]), with the fix: the
-    /// external forces when they drive a sphere at all, else the usual suspects.
-    pub(crate) fn collapse_cause(&self) -> String {
-        match self.fastest_driven_sphere() {
-            Some((k, force, mobility, a)) if force * mobility > 0.0 => format!(
-                "the external forces drive sphere {k} (swimmer {}) at {} m/s, its Stokes speed under {} N, its own radius in {} s: use a smaller external force or weaker gravity (the paper's swimmers weigh about 1e-14 N), or stop the run with Ctrl-C",
-                self.owner(k),
-                short(force * mobility),
-                short(force),
-                short(a / (force * mobility))
-            ),
-            _ => "close or overlapping spheres, stiff contacts or a tight tolerance hold the steps short: s.integrator_info and s.stats tell more; stop the run with Ctrl-C".to_string(),
-        }
+    /// What holds a collapsed run's steps short ([`Scene::collapsed_steps`]), with the fix, for
+    /// steps of `dt` (s): the external forces when they carry a sphere its own radius within ten
+    /// such steps, else the usual suspects.
+    pub(crate) fn collapse_cause(&self) -> CollapseCause {
+        let driven = self
+            .fastest_driven_sphere()
+            .filter(|(_, force, mobility, _)| force * mobility > 0.0)
+            .map(|(k, force, mobility, a)| {
+                let words = format!(
+                    "the external forces drive sphere {k} (swimmer {}) at {} m/s, its Stokes speed under {} N, its own radius in {} s: use a smaller external force or weaker gravity (the paper's swimmers weigh about 1e-14 N), or stop the run with Ctrl-C",
+                    self.owner(k),
+                    short(force * mobility),
+                    short(force),
+                    short(a / (force * mobility))
+                );
+                (a / (force * mobility), words)
+            });
+        CollapseCause { driven }
     }
 
     /// A run's steps have collapsed: from scene time `from` it reached `now` in `steps` steps and
@@ -78,7 +83,7 @@ impl Scene {
         (from, now, t_end): (f64, f64, f64),
         steps: u64,
         wall: std::time::Duration,
-        cause: &str,
+        cause: &CollapseCause,
     ) -> Option<EngineError> {
         let covered = now - from;
         if steps == 0 || covered <= 0.0 {
@@ -89,6 +94,7 @@ impl Scene {
         if !(dt < COLLAPSED_STEP * period && left > COLLAPSED_WAIT.as_secs_f64()) {
             return None;
         }
+        let cause = cause.words(dt);
         Some(invalid!(
             "this run's steps have collapsed to {} s ({} of a stroke period; {steps} steps in {:.1} s): at this pace the {} s left to t = {} s take about {}; {cause}",
             short(dt),
@@ -140,5 +146,23 @@ fn duration_words(seconds: f64) -> String {
         format!("{} hours", short(seconds / 3600.0))
     } else {
         format!("{} days", short(seconds / 86400.0))
+    }
+}
+
+/// What may hold a run's steps short, taken when the run starts: the sphere the external forces
+/// drive fastest, as the time they take to carry it its own radius and the words that say so.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct CollapseCause {
+    driven: Option<(f64, String)>,
+}
+
+impl CollapseCause {
+    /// The cause named for steps of `dt` (s): the external forces where they carry their
+    /// sphere its own radius within ten steps, else the usual suspects.
+    fn words(&self, dt: f64) -> &str {
+        match &self.driven {
+            Some((crossing, words)) if *crossing < 10.0 * dt => words,
+            _ => "close or overlapping spheres, stiff contacts or a tight tolerance hold the steps short: s.integrator_info and s.stats tell more; stop the run with Ctrl-C",
+        }
     }
 }

@@ -61,7 +61,7 @@ impl Scene {
         let half = 0.5 * sides.iter().copied().fold(0.0, f64::max);
         if half > extent.limit {
             return Err(invalid!(
-                "swimmers drawn at random in a cube of side {} m would lie up to {} m from the origin, beyond the {} m that positions may reach ({MAX_EXTENT_IN_RADII:e} times the smallest sphere radius, {} m: there f64 no longer resolves the spheres); give a larger volume fraction (the side is (n v / volume fraction)^(1/3)), or fewer swimmers",
+                "swimmers drawn at random in a cube of side {} m would have coordinates up to {} m, beyond the {} m that positions may reach ({MAX_EXTENT_IN_RADII:e} times the smallest sphere radius, {} m: there f64 no longer resolves the spheres); give a larger volume fraction (the side is (n v / volume fraction)^(1/3)), or fewer swimmers",
                 short(2.0 * half),
                 short(half),
                 short(extent.limit),
