@@ -169,8 +169,8 @@ enum BenchKind {
         #[arg(long, value_name = "TOL")]
         ewald_tol: Option<f64>,
     },
-    /// Whole runs of the spring and rigid-stroke models' suspensions in contact (~1 min; --quick:
-    /// a few seconds): the density study's 64 swimmers at volume fraction 1% with its rod
+    /// Whole runs of the spring and rigid-stroke models' suspensions in contact (~15 s; --quick:
+    /// a second): the density study's 64 swimmers at volume fraction 1% with its rod
     /// repulsion, from placement at auto(1e-4), in open space and in a periodic box, and the
     /// first twentieth of a period of 1,000 rigid swimmers; seconds, right-hand sides and steps
     /// a period.
