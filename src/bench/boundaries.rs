@@ -88,6 +88,13 @@ fn rhs_time(scene: &Scene) -> Result<f64, String> {
     Ok(time)
 }
 
+/// The paper's asymmetric swimmer: a2 = a1/2, a1 = 1.5 Λ with Λ = 0.15 ℓ.
+pub fn asymmetric_swimmer() -> Dumbbell {
+    let mut d = Dumbbell::default();
+    (d.a1, d.a2) = (0.225 * d.ell, 0.1125 * d.ell);
+    d
+}
+
 /// `swimmers` random Fig-1 swimmers at φ = 1% under `model`, in open space, a box (its sums to
 /// `ewald_tol`, else the one the default integrator gives them) and above a wall.
 pub fn measure(
@@ -97,9 +104,7 @@ pub fn measure(
     ewald_tol: Option<f64>,
 ) -> Result<Row, String> {
     let err = |e: crate::engine::EngineError| e.to_string();
-    // The paper's asymmetric swimmer: a2 = a1/2, a1 = 1.5 Λ with Λ = 0.15 ℓ.
-    let mut d = Dumbbell::default();
-    (d.a1, d.a2) = (0.225 * d.ell, 0.1125 * d.ell);
+    let d = asymmetric_swimmer();
     let side = box_side(swimmers, &d, PHI).map_err(err)?;
     let mut scene = Scene::new();
     scene.set_model(model);

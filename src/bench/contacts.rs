@@ -7,10 +7,11 @@
 //! run from placement under `auto(1e-4)`; the open-space scene is the same placement with the box
 //! removed. A run's first period includes the settling of the rods placed within the range.
 
+use super::boundaries::asymmetric_swimmer;
 use super::table::Table;
 use crate::engine::build::{box_side, random_suspension, Orientations, Phases};
 use crate::engine::contacts::{Overlaps, Steric, StericBody, StericLaw};
-use crate::engine::{Dumbbell, IntegratorSpec, Model, Scene, Simulation};
+use crate::engine::{IntegratorSpec, Model, Scene, Simulation};
 use std::time::Instant;
 
 /// The sphere volume fraction of every scene.
@@ -41,8 +42,7 @@ pub struct Row {
 /// The study's scene of `swimmers` under `model`, in its box or in open space.
 pub fn scene(model: Model, swimmers: usize, periodic: bool) -> Result<Scene, String> {
     let err = |e: crate::engine::EngineError| e.to_string();
-    let mut d = Dumbbell::default();
-    (d.a1, d.a2) = (0.225 * d.ell, 0.1125 * d.ell);
+    let d = asymmetric_swimmer();
     let side = box_side(swimmers, &d, PHI).map_err(err)?;
     let mut s = Scene::new();
     s.set_box(Some([side; 3])).map_err(err)?;

@@ -157,14 +157,20 @@ impl RunControl {
         }
     }
 
-    /// The watch a stepper whose steps hold many inner steps shows the state inside them: a
-    /// copy of `s` (made now) takes the inner step's time and state when a look is due.
-    fn inner_watch(&self, s: &Scene, judge: Arc<CollapseJudge>) -> StateWatch {
+    /// The watch a stepper whose steps hold many inner steps shows the state inside them: the
+    /// run's collapse `judge` counts them, and a copy of `s` (made now) takes the inner step's
+    /// time and state when a look is due; `None` with neither a watcher nor a judge.
+    fn inner_watch(&self, s: &Scene, judge: Option<Arc<CollapseJudge>>) -> Option<StateWatch> {
+        if self.watch.is_none() && judge.is_none() {
+            return None;
+        }
         let w = self.watch.clone();
         let shadow = w.as_ref().map(|_| std::sync::Mutex::new(s.clone()));
         let control = self.clone();
-        Arc::new(move |t: f64, y: &[f64]| {
-            judge.step(t, &control);
+        Some(Arc::new(move |t: f64, y: &[f64]| {
+            if let Some(judge) = &judge {
+                judge.step(t, &control);
+            }
             let (Some(w), Some(shadow)) = (&w, &shadow) else {
                 return;
             };
@@ -177,7 +183,7 @@ impl RunControl {
                 }
             }
             w.pace(t);
-        })
+        }))
     }
 
     /// What a watched device run shows its state through between submissions: a copy of `s`
@@ -327,14 +333,12 @@ pub fn advance_cpu(
     let mut stepper = ws.take_stepper(s, spec, &key)?;
     stepper.set_interrupt(control.interrupt.clone());
     // A fixed step is the user's choice, not a collapse.
-    let judge = control.collapse_judge(s, t_end);
-    if spec.fixed_step().is_some() {
-        judge
-            .judged
-            .store(true, std::sync::atomic::Ordering::Relaxed);
-    }
+    let judge = spec
+        .fixed_step()
+        .is_none()
+        .then(|| control.collapse_judge(s, t_end));
     if stepper.watches_inside() {
-        stepper.set_watch(Some(control.inner_watch(s, judge.clone())));
+        stepper.set_watch(control.inner_watch(s, judge.clone()));
     }
     let mut outcome = Ok(());
     let mut taken = 0;
@@ -350,7 +354,7 @@ pub fn advance_cpu(
                 s.time = t;
                 control.report(s.time);
                 control.look(s);
-                if !stepper.watches_inside() {
+                if let Some(judge) = judge.as_ref().filter(|_| !stepper.watches_inside()) {
                     judge.step(s.time, control);
                 }
                 if s.stats.direct_fallbacks > fallbacks {

@@ -105,19 +105,20 @@ pub fn read_request(stream: &mut TcpStream, deadline: Instant) -> Result<Request
         if head.len() > MAX_HEAD {
             return Err(Refusal::TooLarge);
         }
-        let left = deadline.saturating_duration_since(Instant::now());
-        if left.is_zero() {
-            return Err(Refusal::Gone);
-        }
-        stream
-            .set_read_timeout(Some(left))
-            .map_err(|_| Refusal::Gone)?;
-        let n = stream.read(&mut buf).map_err(|_| Refusal::Gone)?;
-        if n == 0 {
-            return Err(Refusal::Gone);
-        }
+        let n = read_by(stream, &mut buf, deadline).ok_or(Refusal::Gone)?;
         head.extend_from_slice(&buf[..n]);
     }
+}
+
+/// Read what `stream` has into `buf`, waiting no later than `deadline`: the count read, or
+/// `None` when the deadline passed, the client closed or the read failed.
+pub fn read_by(stream: &mut TcpStream, buf: &mut [u8], deadline: Instant) -> Option<usize> {
+    let left = deadline.saturating_duration_since(Instant::now());
+    if left.is_zero() {
+        return None;
+    }
+    stream.set_read_timeout(Some(left)).ok()?;
+    stream.read(buf).ok().filter(|&n| n > 0)
 }
 
 /// Write a whole response: `status` (e.g. "200 OK"), its content type and body.

@@ -102,15 +102,7 @@ impl Server {
             clients: Mutex::new(Vec::new()),
             served: AtomicUsize::new(0),
         });
-        let host = match local.ip() {
-            IpAddr::V4(ip) if ip.is_unspecified() => IpAddr::V4(Ipv4Addr::LOCALHOST),
-            ip => ip,
-        };
-        let url = format!(
-            "http://{}/{}/",
-            SocketAddr::new(host, local.port()),
-            shared.token
-        );
+        let url = format!("http://{}/{}/", reachable(local), shared.token);
         let s = shared.clone();
         let accept = std::thread::Builder::new()
             .name("swimlab-view".into())
@@ -162,14 +154,20 @@ impl Drop for Server {
     }
 }
 
-/// Connect to `local` (the loopback of its family when it is unspecified), to wake an accept.
-fn wake(local: SocketAddr) -> bool {
+/// The address a client on this machine reaches the socket bound to `local` at: the loopback
+/// of its family where it is bound to every address.
+fn reachable(local: SocketAddr) -> SocketAddr {
     let ip = match local.ip() {
         IpAddr::V4(ip) if ip.is_unspecified() => IpAddr::V4(Ipv4Addr::LOCALHOST),
         IpAddr::V6(ip) if ip.is_unspecified() => IpAddr::V6(Ipv6Addr::LOCALHOST),
         ip => ip,
     };
-    TcpStream::connect_timeout(&SocketAddr::new(ip, local.port()), WAKE_TIMEOUT).is_ok()
+    SocketAddr::new(ip, local.port())
+}
+
+/// Connect to the server bound to `local`, to wake its accept.
+fn wake(local: SocketAddr) -> bool {
+    TcpStream::connect_timeout(&reachable(local), WAKE_TIMEOUT).is_ok()
 }
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
@@ -286,19 +284,14 @@ fn serve(mut stream: TcpStream, shared: &Shared, reading: &AtomicBool, deadline:
 /// closing with unread bytes does not reset the connection before the client has read the
 /// answer (and a client that trickles bytes holds the thread no longer).
 fn linger(stream: &mut TcpStream) {
-    use std::io::Read;
     let _ = stream.shutdown(std::net::Shutdown::Write);
     let end = Instant::now() + LINGER;
     let mut buf = [0u8; 4096];
     let mut left: usize = 64 * 1024;
     while left > 0 {
-        let now = Instant::now();
-        if now >= end || stream.set_read_timeout(Some(end - now)).is_err() {
-            return;
-        }
-        match stream.read(&mut buf) {
-            Ok(n) if n > 0 => left = left.saturating_sub(n),
-            _ => return,
+        match http::read_by(stream, &mut buf, end) {
+            Some(n) => left = left.saturating_sub(n),
+            None => return,
         }
     }
 }

@@ -14,7 +14,9 @@ impl Steric {
     /// The repulsion between the rods of swimmers `i` and `j` (spheres 2i, 2i+1 and 2j, 2j+1):
     /// the closest points of the two axes, at fractions s and t along them, and the force on
     /// rod `i` there, F = k (δ − gap) r̂ with gap = |r| − a_i(s) − a_j(t), the radii interpolated
-    /// linearly between the spheres'. `None` when out of reach (or the axes cross exactly).
+    /// linearly between the spheres'. `None` when out of reach (or the axes cross exactly). The
+    /// contact points are sought whatever the distance: a loop over many pairs skips the far
+    /// ones first by their bounding spheres ([`apart`]).
     #[inline]
     pub(super) fn rod_force(
         &self,
@@ -30,21 +32,17 @@ impl Steric {
         let d = mid(i) - mid(j);
         let shift = d - separation(periodic, d);
         let (q, d2) = (pos[2 * j] + shift, pos[2 * j + 1] - pos[2 * j]);
-        self.rod_pair_force(
+        self.rod_pair_force_sought(
             (p, d1, [radii[2 * i], radii[2 * i + 1]]),
             (q, d2, [radii[2 * j], radii[2 * j + 1]]),
+            0.0,
         )
     }
 
     /// The repulsion between rod `a` = (start, start-to-end, radii at both ends) and rod `b`, as
-    /// [`Steric::rod_force`]: the fraction s along `a` where it acts and the force on `a`.
-    #[inline]
-    pub(crate) fn rod_pair_force(&self, a: Rod, b: Rod) -> Option<(f64, Vector3<f64>)> {
-        self.rod_pair_force_within(a, b, 0.0)
-    }
-
-    /// [`Steric::rod_pair_force`] carried on to gaps of δ + `extra`, as
-    /// [`Steric::sphere_force_within`].
+    /// [`Steric::rod_force`] (the fraction s along `a` where it acts and the force on `a`), with
+    /// the law carried on to gaps of δ + `extra` as [`Steric::sphere_force_within`]; a pair
+    /// whose bounding spheres lie apart is out of reach without its contact points sought.
     #[inline]
     pub(super) fn rod_pair_force_within(
         &self,
@@ -141,6 +139,14 @@ impl Steric {
         parallel: bool,
     ) {
         let swimmers = pos.len() / 2;
+        // Each rod's bounding sphere: pairs whose spheres lie beyond the range are skipped
+        // before their contact points are sought, and the cells hold the midpoints.
+        let spheres: Vec<(Vector3<f64>, f64)> = (0..swimmers)
+            .map(|k| {
+                let rod = (pos[2 * k], pos[2 * k + 1] - pos[2 * k]);
+                bounding_sphere((rod.0, rod.1, [radii[2 * k], radii[2 * k + 1]]))
+            })
+            .collect();
         let longest = (0..swimmers)
             .map(|k| (pos[2 * k + 1] - pos[2 * k]).norm())
             .fold(0.0, f64::max);
@@ -148,11 +154,7 @@ impl Steric {
         let fits = periodic.is_none_or(|b| reach_max <= 0.5 * b.shortest());
         let grid = (pos.len() >= super::super::gaps::CELL_LIST_SPHERES && fits && reach_max > 0.0)
             .then(|| {
-                let mid = |d: usize| -> Vec<f64> {
-                    (0..swimmers)
-                        .map(|k| 0.5 * (pos[2 * k][d] + pos[2 * k + 1][d]))
-                        .collect()
-                };
+                let mid = |d: usize| -> Vec<f64> { spheres.iter().map(|(m, _)| m[d]).collect() };
                 super::super::cells::CellGrid::build_in(
                     &mid(0),
                     &mid(1),
@@ -161,21 +163,15 @@ impl Steric {
                     periodic,
                 )
             });
-        // Each rod's midpoint and its bounding radius (half its length and its larger radius):
-        // pairs whose bounding spheres lie beyond the range are skipped before the rods' contact
-        // points are sought (as `out_of_reach`, with the same margin).
-        let mids: Vec<Vector3<f64>> = (0..swimmers)
-            .map(|k| (pos[2 * k] + pos[2 * k + 1]) * 0.5)
-            .collect();
-        let bounds: Vec<f64> = (0..swimmers)
-            .map(|k| {
-                0.5 * (pos[2 * k + 1] - pos[2 * k]).norm() + radii[2 * k].max(radii[2 * k + 1])
-            })
-            .collect();
         let row = |i: usize, f: &mut [Vector3<f64>]| {
             let add = |j: usize| {
-                let bound = (self.range + bounds[i] + bounds[j]) * (1.0 + OUT_OF_REACH_MARGIN);
-                if separation(periodic, mids[i] - mids[j]).norm_squared() > bound * bound {
+                let ((mi, bi), (mj, bj)) = (spheres[i], spheres[j]);
+                if apart(
+                    separation(periodic, mi - mj).norm_squared(),
+                    bi,
+                    bj,
+                    self.range,
+                ) {
                     return;
                 }
                 if let Some((s, df)) = self.rod_force(pos, radii, periodic, i, j) {
@@ -215,21 +211,33 @@ impl Steric {
     }
 }
 
-/// Whether rods `a` and `b` lie beyond any reach `range` plus their radii whatever their contact
-/// points: every point of a rod lies within half its length of its midpoint, so no two points
-/// are closer than the midpoints' distance less both half lengths. A pair is skipped only when
-/// that bound clears the largest reach by [`OUT_OF_REACH_MARGIN`] (rounding of far positions),
-/// so a skipped pair is one the exact test would find out of reach: a cheap test for the many
-/// far pairs, bitwise the same forces.
+/// A rod's bounding sphere: its midpoint, and half its length plus its larger radius. No point
+/// of the rod's body lies outside it.
 #[inline]
-fn out_of_reach(a: Rod, b: Rod, range: f64) -> bool {
-    let ((p, d1, ra), (q, d2, rb)) = (a, b);
-    let reach = range + ra[0].max(ra[1]) + rb[0].max(rb[1]);
-    let bound = (reach + 0.5 * (d1.norm() + d2.norm())) * (1.0 + OUT_OF_REACH_MARGIN);
-    ((p + d1 * 0.5) - (q + d2 * 0.5)).norm_squared() > bound * bound
+fn bounding_sphere((p, d, r): Rod) -> (Vector3<f64>, f64) {
+    (p + d * 0.5, 0.5 * d.norm() + r[0].max(r[1]))
 }
 
-/// The relative margin of [`out_of_reach`]'s bound: positions up to 1e8 radii from the origin
+/// Whether two bounding spheres of radii `ra` and `rb`, their centres `d2` apart squared, lie
+/// farther apart than `range`: then no two points of their rods' bodies come within it. The
+/// bound is widened by [`OUT_OF_REACH_MARGIN`] (the rounding of far positions), so a pair it
+/// skips is one the contact points would find out of reach: a cheap test for the many far
+/// pairs, bitwise the same forces.
+#[inline]
+fn apart(d2: f64, ra: f64, rb: f64, range: f64) -> bool {
+    let bound = (range + ra + rb) * (1.0 + OUT_OF_REACH_MARGIN);
+    d2 > bound * bound
+}
+
+/// Whether rods `a` and `b` lie beyond `range` of each other whatever their contact points
+/// ([`apart`] of their bounding spheres).
+#[inline]
+fn out_of_reach(a: Rod, b: Rod, range: f64) -> bool {
+    let ((ma, ra), (mb, rb)) = (bounding_sphere(a), bounding_sphere(b));
+    apart((ma - mb).norm_squared(), ra, rb, range)
+}
+
+/// The relative margin of [`apart`]'s bound: positions up to 1e8 radii from the origin
 /// (the reach they are held to) round at ~1e-8 of a radius, far below it.
 const OUT_OF_REACH_MARGIN: f64 = 1e-6;
 

@@ -53,23 +53,13 @@ impl Scene {
             .max_by(|p, q| (p.1 * p.2).total_cmp(&(q.1 * q.2)))
     }
 
-    /// What holds a collapsed run's steps short ([`Scene::collapsed_steps`]), with the fix, for
-    /// steps of `dt` (s): the external forces when they carry a sphere its own radius within ten
-    /// such steps, else the usual suspects.
+    /// What may hold a run's steps short ([`Scene::collapsed_steps`]): the sphere the external
+    /// forces drive fastest, if they drive one at all.
     pub(crate) fn collapse_cause(&self) -> CollapseCause {
         let driven = self
             .fastest_driven_sphere()
             .filter(|(_, force, mobility, _)| force * mobility > 0.0)
-            .map(|(k, force, mobility, a)| {
-                let words = format!(
-                    "the external forces drive sphere {k} (swimmer {}) at {} m/s, its Stokes speed under {} N, its own radius in {} s: use a smaller external force or weaker gravity (the paper's swimmers weigh about 1e-14 N), or stop the run with Ctrl-C",
-                    self.owner(k),
-                    short(force * mobility),
-                    short(force),
-                    short(a / (force * mobility))
-                );
-                (a / (force * mobility), words)
-            });
+            .map(|(k, force, mobility, a)| (k, self.owner(k), force, mobility, a));
         CollapseCause { driven }
     }
 
@@ -150,19 +140,24 @@ fn duration_words(seconds: f64) -> String {
 }
 
 /// What may hold a run's steps short, taken when the run starts: the sphere the external forces
-/// drive fastest, as the time they take to carry it its own radius and the words that say so.
+/// drive fastest (sphere, its swimmer, |F| in N, its mobility in m/(N s), its radius in m).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct CollapseCause {
-    driven: Option<(f64, String)>,
+    driven: Option<(usize, usize, f64, f64, f64)>,
 }
 
 impl CollapseCause {
-    /// The cause named for steps of `dt` (s): the external forces where they carry their
-    /// sphere its own radius within ten steps, else the usual suspects.
-    fn words(&self, dt: f64) -> &str {
-        match &self.driven {
-            Some((crossing, words)) if *crossing < 10.0 * dt => words,
-            _ => "close or overlapping spheres, stiff contacts or a tight tolerance hold the steps short: s.integrator_info and s.stats tell more; stop the run with Ctrl-C",
+    /// The cause named, with its fix, for steps of `dt` (s): the external forces where they
+    /// carry their sphere its own radius within ten steps, else the usual suspects.
+    fn words(&self, dt: f64) -> String {
+        match self.driven {
+            Some((k, swimmer, force, mobility, a)) if a / (force * mobility) < 10.0 * dt => format!(
+                "the external forces drive sphere {k} (swimmer {swimmer}) at {} m/s, its Stokes speed under {} N, its own radius in {} s: use a smaller external force or weaker gravity (the paper's swimmers weigh about 1e-14 N), or stop the run with Ctrl-C",
+                short(force * mobility),
+                short(force),
+                short(a / (force * mobility))
+            ),
+            _ => "close or overlapping spheres, stiff contacts or a tight tolerance hold the steps short: s.integrator_info and s.stats tell more; stop the run with Ctrl-C".into(),
         }
     }
 }
