@@ -42,6 +42,7 @@ mod bad_input_runs;
 mod bad_input_types_limits_files;
 mod book;
 mod bulk_suspensions;
+mod checkpoints;
 mod collective;
 mod continuum;
 mod engine_messages;

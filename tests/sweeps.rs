@@ -282,3 +282,56 @@ fn a_real_slurm_cluster_runs_the_job_array() {
     assert!(status.success(), "sbatch --wait: {status}");
     cluster_equals_local(&d);
 }
+
+/// A point whose script takes checkpoints and was cut off after some (here: it stops with an
+/// error after its first period the first time) goes on from its last checkpoint under
+/// `--resume`, in its own folder, and ends as the point that ran through: the same checksum.
+#[test]
+fn resume_takes_a_cut_off_point_on_from_its_checkpoint() {
+    let d = dir("checkpoint");
+    std::fs::write(
+        d.join("long.rhai"),
+        r#"
+let cut = param("cut", 0);
+let s = scene();
+s.add_random(dumbbell(), 3, 1e-3, 5);
+let r = s.record([R_H(0)], 0.25);
+r.stream_csv("rows.csv");
+let resumed = s.checkpoint("run.checkpoint.json", 0.5);
+s.run_to_periods(1.2);
+if cut == 1 && !resumed { throw "cut off (a stand-in for a time limit)"; }
+s.run_to_periods(2.0);
+print(`resumed=${resumed} checksum=${s.checksum} rows=${r.len}`);
+"#,
+    )
+    .unwrap();
+    let args = [
+        "sweep",
+        "long.rhai",
+        "--grid",
+        "cut=0,1",
+        "--out",
+        "out",
+        "--jobs",
+        "2",
+    ];
+    let out = swimlab(&args, &d);
+    assert_eq!(out.status.code(), Some(1));
+    let mut resume = args.to_vec();
+    resume.push("--resume");
+    let out = swimlab(&resume, &d);
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{text}");
+    let stdout = |k: usize| std::fs::read_to_string(d.join(format!("out/{k}/stdout.txt"))).unwrap();
+    let (whole, cut) = (stdout(0), stdout(1));
+    assert!(whole.starts_with("resumed=false"), "{whole}");
+    assert_eq!(cut.replace("resumed=true", "resumed=false"), whole);
+    assert!(cut.starts_with("resumed=true"), "{cut}");
+    assert!(std::fs::read_to_string(d.join("out/1/stderr.txt"))
+        .unwrap()
+        .contains("going on from the checkpoint run.checkpoint.json at t = "));
+    assert_eq!(
+        std::fs::read(d.join("out/0/rows.csv")).unwrap(),
+        std::fs::read(d.join("out/1/rows.csv")).unwrap()
+    );
+}

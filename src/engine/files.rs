@@ -292,6 +292,11 @@ impl LineStream {
         Ok(s)
     }
 
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// Whether this stream writes `path`.
     pub fn is_at(&self, path: &Path) -> bool {
         self.claim.is_on(path)

@@ -13,6 +13,7 @@ pub mod build;
 pub(crate) mod calibrate;
 pub(crate) mod cells;
 pub(crate) mod cg;
+pub mod checkpoint;
 pub mod choice;
 pub(crate) mod contacts;
 pub mod continuum;

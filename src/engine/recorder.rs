@@ -314,6 +314,100 @@ impl Recorder {
         Ok(())
     }
 
+    /// What a checkpoint keeps of this recorder ([`RecorderMark`]); a trajectory's frames cannot
+    /// be taken back after a kill, so a trajectory is refused.
+    pub fn mark(&self) -> Result<RecorderMark> {
+        self.check_resumable()?;
+        Ok(RecorderMark {
+            columns: self.columns(),
+            trigger: self.trigger.clone(),
+            start: self.start,
+            next_k: self.next_k,
+            rows: self
+                .rows
+                .iter()
+                .map(|r| csv_line(r.iter().map(f64_field)))
+                .collect(),
+        })
+    }
+
+    /// Refuse a recorder a checkpoint cannot carry: a trajectory, whose frames written after the
+    /// last checkpoint cannot be taken back (a run started again would write them twice).
+    pub fn check_resumable(&self) -> Result<()> {
+        match &self.frames {
+            Some(_) => Err(invalid!(
+                "{} cannot go on from a checkpoint: its frames written after the last checkpoint would be written again; record rows (s.record, rec.stream_csv) in a checkpointed run, and write trajectories in a run of their own (or save the scene at each checkpoint and write frames from the saved scenes)",
+                self.name()
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// Refuse a checkpoint's mark written by another recorder than this one (other columns,
+    /// trigger or origin), naming the difference.
+    pub fn check_mark(&self, m: &RecorderMark) -> Result<()> {
+        if m.columns != self.columns() {
+            return Err(invalid!(
+                "it recorded {}, this recorder records {}",
+                m.columns.join(", "),
+                self.columns().join(", ")
+            ));
+        }
+        if m.trigger != self.trigger || m.start != self.start {
+            return Err(invalid!(
+                "it recorded {} from t = {:e} s, this recorder {} from t = {:e} s",
+                m.trigger.describe(),
+                m.start,
+                self.trigger.describe(),
+                self.start
+            ));
+        }
+        Ok(())
+    }
+
+    /// The rows of a checkpoint's mark of this recorder, read and checked (its columns, trigger
+    /// and origin this recorder's, every row as wide as this recorder's).
+    pub fn rows_of(&self, m: &RecorderMark) -> Result<Vec<Vec<f64>>> {
+        self.check_mark(m)?;
+        let width = self.columns().len();
+        m.rows
+            .iter()
+            .map(|line| {
+                let row: Vec<f64> = line
+                    .split(',')
+                    .map(str::parse)
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(|_| invalid!("a row that is not numbers: {line}"))?;
+                if row.len() == width {
+                    Ok(row)
+                } else {
+                    Err(invalid!(
+                        "a row of {} values where the recorder has {width} columns",
+                        row.len()
+                    ))
+                }
+            })
+            .collect()
+    }
+
+    /// Go on from a checkpoint's mark `m`, whose rows [`Recorder::rows_of`] read: those rows in
+    /// place of this recorder's, its next sample, and this recorder's CSV stream, if any, written
+    /// anew with exactly those rows (rows streamed after the checkpoint are taken back).
+    /// `retiring` is the owner's flag ([`super::files::Claim::take`]).
+    pub fn resume_from(
+        &mut self,
+        m: &RecorderMark,
+        rows: Vec<Vec<f64>>,
+        retiring: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    ) -> Result<()> {
+        self.rows = rows;
+        self.next_k = m.next_k;
+        if let Some(path) = self.stream.as_ref().map(|s| s.path().to_path_buf()) {
+            self.stream_csv(&path, retiring)?;
+        }
+        Ok(())
+    }
+
     /// Write the rows as CSV with a header carrying names and units (to a temporary file renamed
     /// over `path`: a crash keeps the old file whole).
     pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
@@ -327,6 +421,18 @@ impl Recorder {
             csv.flush()
         })
     }
+}
+
+/// What a checkpoint keeps of a recorder: what it records and from when (to check that the same
+/// recorder takes it back), its next periodic sample, and its rows as CSV lines (text that reads
+/// back to the same f64, NaN and infinities included).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RecorderMark {
+    columns: Vec<String>,
+    trigger: Trigger,
+    start: f64,
+    next_k: u64,
+    rows: Vec<String>,
 }
 
 /// A number as CSV writes it here: the shortest text that reads back to the same f64.

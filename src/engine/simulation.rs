@@ -6,6 +6,7 @@
 //! settings change through [`Simulation::scene_mut`].
 
 use super::advance::{advance_to, check_steps, Probe};
+use super::checkpoint::Checkpoints;
 use super::error::{invalid, require_finite, Result};
 use super::observable::Observable;
 use super::plan;
@@ -42,6 +43,8 @@ pub struct Simulation {
     /// Whether this simulation is being replaced: its recorders' files may be taken over.
     retiring: Arc<AtomicBool>,
     watcher: Option<Arc<dyn Watcher>>,
+    /// Where and when runs write checkpoints, if they do.
+    checkpoints: Option<Checkpoints>,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -54,6 +57,7 @@ impl std::fmt::Debug for Simulation {
             .field("control", &self.control)
             .field("retiring", &self.retiring)
             .field("watcher", &self.watcher.is_some())
+            .field("checkpoints", &self.checkpoints)
             .finish()
     }
 }
@@ -192,7 +196,27 @@ impl Simulation {
                 "duration must be >= 0 s, got {duration}; the dynamics cannot run backwards"
             ));
         }
-        let t_end = self.scene.time() + duration;
+        self.run_unwatched_to(self.scene.time() + duration)
+    }
+
+    /// Advance the scene until its time is `t_end` (s), as [`Simulation::run`] does; a time the
+    /// scene has reached already runs nothing and takes no row (so that a script that runs to
+    /// absolute times goes on where a checkpoint left it).
+    pub fn run_to(&mut self, t_end: f64) -> Result<()> {
+        require_finite("the end time", t_end)?;
+        if t_end <= self.scene.time() {
+            return Ok(());
+        }
+        let Some(w) = self.watcher.clone() else {
+            return self.run_unwatched_to(t_end);
+        };
+        w.settled(&self.scene, &self.recorders);
+        let outcome = self.run_unwatched_to(t_end);
+        w.settled(&self.scene, &self.recorders);
+        outcome
+    }
+
+    fn run_unwatched_to(&mut self, t_end: f64) -> Result<()> {
         self.check_run(t_end)?;
         self.control.begin_run_to(t_end);
         if t_end > self.scene.time() {
@@ -207,6 +231,7 @@ impl Simulation {
                 .recorders
                 .iter()
                 .filter_map(|r| r.next_due(now))
+                .chain(self.checkpoints.as_ref().map(Checkpoints::next_due))
                 .fold(t_end, f64::min)
                 .max(now);
             advance_to(
@@ -217,10 +242,55 @@ impl Simulation {
             )?;
             let end_of_run = self.scene.time() >= t_end;
             self.fire_recorders(end_of_run)?;
+            self.take_checkpoint()?;
             if end_of_run {
                 return Ok(());
             }
         }
+    }
+
+    /// Write a checkpoint if one is due now; its stepper then starts afresh, as a run resumed
+    /// from the checkpoint does.
+    fn take_checkpoint(&mut self) -> Result<()> {
+        let Some(c) = &mut self.checkpoints else {
+            return Ok(());
+        };
+        if c.take_if_due(&self.scene, &self.recorders)? {
+            self.workspace.forget_stepper();
+        }
+        Ok(())
+    }
+
+    /// From now on, write a checkpoint to `path` on the periodic `trigger` (every n periods or
+    /// t seconds of scene time from now, see [`super::checkpoint`]); if `path` holds a checkpoint of this setup (this scene
+    /// as it is now, the same trigger, the same recorders), go on from it: the scene and every
+    /// recorder's rows become the checkpoint's (CSV streams written anew with those rows), and
+    /// its time is returned. Trajectories are refused: their frames cannot be taken back.
+    pub fn checkpoint(&mut self, path: &std::path::Path, trigger: &Trigger) -> Result<Option<f64>> {
+        for r in &self.recorders {
+            r.check_resumable()?;
+        }
+        let mut c = Checkpoints::new(path, &self.scene, trigger)?;
+        let resumed = match c.resume(&self.recorders)? {
+            None => None,
+            Some(saved) => {
+                // Every mark was read and checked before any recorder changes.
+                for (r, (m, rows)) in self.recorders.iter_mut().zip(saved.recorders) {
+                    r.resume_from(&m, rows, Some(self.retiring.clone()))?;
+                }
+                self.scene = saved.scene;
+                self.workspace.forget_stepper();
+                self.show_watcher();
+                Some(self.scene.time())
+            }
+        };
+        self.checkpoints = Some(c);
+        Ok(resumed)
+    }
+
+    /// The checkpoint schedule's file, if runs write checkpoints.
+    pub fn checkpoint_path(&self) -> Option<&std::path::Path> {
+        self.checkpoints.as_ref().map(Checkpoints::path)
     }
 
     /// Advance by `n` stroke periods (requires a common ω).
@@ -305,6 +375,12 @@ impl Simulation {
     /// recorder that writes it (its rows are the frames' times).
     pub fn trajectory(&mut self, path: &std::path::Path, trigger: Trigger) -> Result<usize> {
         trigger.validate()?;
+        if let Some(c) = self.checkpoint_path() {
+            return Err(invalid!(
+                "a trajectory cannot be written in a run that takes checkpoints ({}): its frames written after the last checkpoint would be written again when the run goes on from it; write the trajectory in a scene of its own (a copy), or record rows with s.record",
+                c.display()
+            ));
+        }
         let t = super::trajectory::Trajectory::create(path, Some(self.retiring.clone()))?;
         let mut probe = Probe::new(&mut self.probes, &self.control);
         let r = Recorder::start_trajectory(&self.scene, t, trigger, &mut probe)?;

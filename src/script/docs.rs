@@ -40,6 +40,7 @@ pub static DOCS: LazyLock<Vec<Doc>> = LazyLock::new(|| {
         super::continuum_api::DOCS,
         super::integrator_api::DOCS,
         super::observable_api::DOCS,
+        super::checkpoint_api::DOCS,
         super::collective_api::DOCS,
         super::params::DOCS,
         super::csv_api::DOCS,

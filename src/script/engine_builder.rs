@@ -2,10 +2,10 @@
 
 use super::source::{read_text, strip_bom, MAX_SOURCE_BYTES};
 use super::{
-    collective_api, continuum_api, csv_api, dumbbell_api, field_api, float_cmp, integrator_api,
-    interrupt, limits, observable_api, panic_guard::guard, params, picture_api, plot_api,
-    render_error, scene_api, scene_settings_api, signatures, stdlib, sweep_api, types, util_api,
-    view_api, wall_api, wrong_calls,
+    checkpoint_api, collective_api, continuum_api, csv_api, dumbbell_api, field_api, float_cmp,
+    integrator_api, interrupt, limits, observable_api, panic_guard::guard, params, picture_api,
+    plot_api, render_error, scene_api, scene_settings_api, signatures, stdlib, sweep_api, types,
+    util_api, view_api, wall_api, wrong_calls,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -38,6 +38,7 @@ pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModu
     scene_settings_api::register(&mut engine);
     wall_api::register(&mut engine);
     observable_api::register(&mut engine);
+    checkpoint_api::register(&mut engine);
     collective_api::register(&mut engine);
     float_cmp::register(&mut engine);
     csv_api::register(&mut engine);

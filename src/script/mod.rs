@@ -1,6 +1,7 @@
 //! Rhai bindings of the engine: one [`engine()`] builder used by the binary, the REPL, the tests and
 //! the examples; one error renderer ([`render_error`]).
 
+mod checkpoint_api;
 mod collective_api;
 pub mod console;
 mod continuum_api;

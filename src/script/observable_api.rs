@@ -61,7 +61,7 @@ fn axis(v: &Dynamic) -> ScriptResult<Vector3<f64>> {
     Ok(a / n)
 }
 
-fn trigger_of(v: &Dynamic) -> ScriptResult<Trigger> {
+pub(super) fn trigger_of(v: &Dynamic) -> ScriptResult<Trigger> {
     if let Some(t) = v.clone().try_cast::<Trigger>() {
         return Ok(t);
     }

@@ -187,7 +187,7 @@ impl SceneHandle {
     }
 
     /// Run.
-    fn with_sim<T>(
+    pub(super) fn with_sim<T>(
         &self,
         f: impl FnOnce(&mut Simulation) -> crate::engine::Result<T>,
     ) -> ScriptResult<T> {
@@ -578,6 +578,27 @@ pub fn register(engine: &mut Engine) {
                 })
             },
         )
+        .register_fn(
+            "run_to",
+            |s: &mut SceneHandle, t: Dynamic| -> ScriptResult<()> {
+                let t = number("run_to(t)", &t)?;
+                s.with_sim(|sim| {
+                    let d = (t - sim.time()).max(0.0);
+                    with_bar(sim, d, |sim| sim.run_to(t))
+                })
+            },
+        )
+        .register_fn(
+            "run_to_periods",
+            |s: &mut SceneHandle, n: Dynamic| -> ScriptResult<()> {
+                let n = number("run_to_periods(n)", &n)?;
+                s.with_sim(|sim| {
+                    let t = n * sim.period()?;
+                    let d = (t - sim.time()).max(0.0);
+                    with_bar(sim, d, |sim| sim.run_to(t))
+                })
+            },
+        )
         .register_get("stats", |s: &mut SceneHandle| {
             let st = s.borrow().stats();
             let mut m = rhai::Map::new();
@@ -636,6 +657,8 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("add_at", "scene", "s.add_at(d, centres: array) -> int", "Add a copy of dumbbell d (its orientation and phase) at every centre [x, y, z] (m) of the array, e.g. a lattice from the stdlib module \"lattice\". All or nothing: if one does not fit, the scene is unchanged. Returns the new swimmer count.", "import \"lattice\" as lattice; let s = scene(); s.add_at(dumbbell(), lattice::cubic(2, 2, 2, 20e-6)); print(s.count);"),
     doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
     doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
+    doc_entry!("run_to", "running", "s.run_to(t)", "Advance until the scene's time is t (s); a time the scene has reached already runs nothing and takes no row. With s.checkpoint, a script that runs to absolute times goes on where a checkpoint left it.", "let s = scene(); s.add(dumbbell()); s.run_to(1e-3); s.run_to(1e-3); print(s.time);"),
+    doc_entry!("run_to_periods", "running", "s.run_to_periods(n)", "Advance until the scene's time is n stroke periods 2 pi/omega (the swimmers' omega must agree); nothing where it is there already (see run_to).", "let s = scene(); s.add(dumbbell()); s.run_to_periods(2); print(s.time);"),
     doc_entry!("diffusion", "thermal", "s.diffusion(i) -> map", "Swimmer i's diffusion as a rigid dumbbell of length ell at the scene's temperature and mobility: parallel and perpendicular translation D_par, D_perp (m^2/s), their orientation average translation = (D_par + 2 D_perp)/3 (a centre's mean squared displacement grows as 6 translation t), rotation D_r (1/s), and offset: where along N from R_H translation and rotation decouple (m). All zero at 0 K. The averaged model's noise; for a symmetric dumbbell translation equals kT/(12 pi mu)(1/a + 1/ell).", "let s = scene(); s.add(dumbbell()); s.temperature = 300; print(s.diffusion(0).translation);"),
     doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations; macro_steps and micro_periods of stroboscopic averaging, and direct_fallbacks and fallback_periods, the times its macro steps failed at their shortest length and the periods it then integrated directly (s.integrator_info says why); noisy_steps, the steps taken with thermal noise (also the noise generator's counter); refined_steps, the short steps suspension(tol) took for a few swimmers inside its steps.", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
     doc_entry!("sphere_velocities", "reading", "s.sphere_velocities(forces) -> [[vx, vy, vz], ...]", "Sphere velocities (m/s) for given forces (N): one [fx, fy, fz] per sphere, swimmer by swimmer, the a1 sphere first; the scene's mobility and viscosity at the present sphere positions, Stokes drag included. For checks against other codes; the scene does not move.", "let s = scene(); s.add(dumbbell()); print(s.sphere_velocities([[1e-12, 0, 0], [0, 0, 0]]));"),

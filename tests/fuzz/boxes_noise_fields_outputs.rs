@@ -1,5 +1,5 @@
 //! A seeded fuzz of boxes and Ewald sums, thermal noise, fields and the structure factor,
-//! stroboscopic averaging and `auto`, trajectories, pictures and animations, sweeps (shared scenes
+//! stroboscopic averaging and `auto`, trajectories, checkpoints, pictures and animations, sweeps (shared scenes
 //! included), notes and the one-writer-per-file rule. A few hundred short scripts of random calls
 //! with random, often hostile, arguments, each starting from one of several scenes (open space, a
 //! box, the averaged model, noise). Every script must end by itself or stop promptly when
@@ -198,6 +198,14 @@ const CALLS: &[&str] = &[
     "s.save(P)",
     "s = load_scene(P)",
     "load_scene(P).run_periods(V)",
+    // Checkpoints.
+    "s.checkpoint(P, V)",
+    "b.checkpoint(P, V)",
+    "s.checkpoint(P, every_seconds(V))",
+    "s.run_to(V)",
+    "s.run_to_periods(V)",
+    "b.run_to_periods(V)",
+    "s.checksum",
     // Pictures and animations.
     "plot(V)",
     "plot(P, V)",

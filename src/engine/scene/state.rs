@@ -120,6 +120,17 @@ impl Scene {
         self.time
     }
 
+    /// A 64-bit checksum (FNV-1a) of the time and every state value's bits: two runs that end
+    /// with the same checksum ended, all but certainly, bit for bit alike.
+    pub fn checksum(&self) -> u64 {
+        std::iter::once(self.time)
+            .chain(self.state.iter().copied())
+            .flat_map(|v| v.to_bits().to_le_bytes())
+            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            })
+    }
+
     /// Work counters accumulated over all runs.
     pub fn stats(&self) -> Stats {
         self.stats
