@@ -292,7 +292,7 @@ fn what_a_checkpoint_cannot_carry_is_refused() {
 fn settings_changed_after_checkpoint_are_refused_when_the_checkpoint_is_due() {
     case(
         "let s = scene(); s.add(dumbbell()); s.checkpoint(\"c.json\", 1); s.run_to_periods(0.5); s.mu = 2e-3; s.run_to_periods(2);",
-        &["the scene's settings changed since checkpoint() was called (in \"mu\")", "set the scene up before s.checkpoint()"],
+        &["the scene's settings changed since checkpoint() was called (in \"mu\")", "set the scene up before asking for checkpoints"],
         1,
     );
 }

@@ -1059,3 +1059,130 @@ fn run_with_view_keeps_the_page_up_after_the_script_until_ctrl_c() {
     assert!(child.wait().unwrap().success());
     assert!(TcpStream::connect(addr).is_err());
 }
+
+/// A seeded fuzz of the view's server: 400 requests made from honest ones (a byte changed, the
+/// head cut short, a method, version, path or header drawn from hostile values, bytes that are
+/// not text), eight connections at a time, each sent whole and the sending side then closed. Every
+/// one gets a status line the server gives (or none, where it closed at once), within the head's
+/// deadline (a stream of frames is read to its head); after all of them, honest requests still
+/// get their answers: no lock-out, no panic.
+#[test]
+fn a_fuzz_of_requests_gets_answers_and_leaves_the_server_serving() {
+    let _few = FEW_SOCKETS.lock().unwrap_or_else(|e| e.into_inner());
+    let mut sim = Simulation::new(pair(Vector3::zeros()));
+    let server = serve(&mut sim, None);
+    let (addr, path) = (server.local_addr(), path_of(server.url()));
+    let methods = [
+        "GET", "HEAD", "POST", "get", "", "G\0T", "OPTIONS", "GET GET",
+    ];
+    let targets = [
+        format!("{path}frame"),
+        format!("{path}frames"),
+        path.clone(),
+        format!("{path}../frame"),
+        "/".into(),
+        "*".into(),
+        format!("{path}frame?x=1"),
+        format!("{path}%00"),
+        "http://example.com/".into(),
+        "/".repeat(5000),
+    ];
+    let versions = [
+        "HTTP/1.1",
+        "HTTP/1.0",
+        "HTTP/2.0",
+        "HTTP/1.1 extra",
+        "http/1.1",
+        "",
+        "HTTP/1.12",
+    ];
+    let headers = [
+        "Host: x",
+        "",
+        "Host:",
+        ": value",
+        "Connection: keep-alive",
+        "Transfer-Encoding: chunked",
+        "Content-Length: 100",
+        "Content-Length: -1",
+        "X: \u{00e9}\u{4e2d}",
+    ];
+    let mut rng = crate::common::Rng(67_2026);
+    let requests: Vec<Vec<u8>> = (0..400)
+        .map(|k| {
+            let pick = |rng: &mut crate::common::Rng, n: usize| (rng.next() % n as u64) as usize;
+            let head = format!(
+                "{} {} {}\r\n{}\r\n{}\r\n\r\n",
+                methods[pick(&mut rng, methods.len())],
+                targets[pick(&mut rng, targets.len())],
+                versions[pick(&mut rng, versions.len())],
+                headers[pick(&mut rng, headers.len())],
+                headers[pick(&mut rng, headers.len())],
+            );
+            let mut bytes = head.into_bytes();
+            let at = pick(&mut rng, bytes.len());
+            match k % 4 {
+                0 => bytes.truncate(at),
+                1 => bytes[at] = (rng.next() & 0xff) as u8,
+                2 => bytes
+                    .splice(
+                        at..at,
+                        (0..pick(&mut rng, 64)).map(|_| (rng.next() & 0xff) as u8),
+                    )
+                    .for_each(drop),
+                _ => {}
+            }
+            bytes
+        })
+        .collect();
+    let next = std::sync::Mutex::new(requests.iter().enumerate());
+    let answered = [0, 200, 400, 404, 405, 431, 505];
+    std::thread::scope(|scope| {
+        for _ in 0..8 {
+            scope.spawn(|| loop {
+                let Some((k, bytes)) = next.lock().unwrap().next() else {
+                    break;
+                };
+                let mut c = TcpStream::connect(addr).unwrap();
+                c.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+                let started = Instant::now();
+                // A client the server already closed on may fail to send the rest: fine.
+                let _ = c.write_all(bytes);
+                let _ = c.shutdown(std::net::Shutdown::Write);
+                // The answer's head (a stream of frames goes on after it): read to its end.
+                let mut text = Vec::new();
+                let mut chunk = [0u8; 4096];
+                while !text.windows(4).any(|w| w == b"\r\n\r\n") {
+                    match c.read(&mut chunk) {
+                        Ok(n) if n > 0 => text.extend_from_slice(&chunk[..n]),
+                        _ => break,
+                    }
+                }
+                let text = String::from_utf8_lossy(&text);
+                let code: u16 = text
+                    .split_whitespace()
+                    .nth(1)
+                    .and_then(|w| w.parse().ok())
+                    .unwrap_or(0);
+                assert!(
+                    answered.contains(&code) && (code == 0 || text.starts_with("HTTP/1.1 ")),
+                    "request {k} {:?} got {:?}",
+                    String::from_utf8_lossy(bytes),
+                    &text[..text.len().min(200)]
+                );
+                assert!(
+                    started.elapsed() < Duration::from_secs(7),
+                    "request {k} {:?} took {:?}",
+                    String::from_utf8_lossy(bytes),
+                    started.elapsed()
+                );
+            });
+        }
+    });
+    let (code, body) = request(addr, "GET", &format!("{path}frame"));
+    assert_eq!(code, 200);
+    assert!(body.contains("\"t\""), "{body}");
+    sim.run(10.0 * DT).unwrap();
+    let frames = read_frames(addr, &path, 0.0, Duration::from_secs(10));
+    assert!(!frames.is_empty());
+}

@@ -130,7 +130,7 @@ impl Checkpoints {
         let now = scene_value(scene)?;
         if let Some(what) = settings_difference(&self.setup, &now) {
             return Err(invalid!(
-                "checkpoint {}: the scene's settings changed since checkpoint() was called (in {what}); a run that goes on from a checkpoint starts from the setup as it was then, so it would not make the change: set the scene up before s.checkpoint(), or take checkpoints in a scene of its own for each stage",
+                "checkpoint {}: the scene's settings changed since checkpoint() was called (in {what}); a run that goes on from a checkpoint starts from the setup as it was then, so it would not make the change: set the scene up before asking for checkpoints, or take checkpoints in a scene of its own for each stage",
                 self.path.display()
             ));
         }
