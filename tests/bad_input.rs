@@ -1,5 +1,4 @@
-//! Issue 13, "nothing lost, nothing hangs": every case of bad input found by trying swimlab as a
-//! new user would, as a table of (script, expected message fragment, exit code). Each runs in its
+//! Nothing lost, nothing hangs: cases of bad input a new user meets, as a table of (script, expected message fragment, exit code). Each runs in its
 //! own `swimlab` process under a time limit, so a hang or an abort fails the test instead of
 //! stalling it, and a panic shows as the "internal error" the script boundary turns it into.
 
@@ -21,7 +20,7 @@ fn check(what: &str, out: &Output, fragment: &str, code: i32) {
 const PAIR: &str = "let s = scene();\ns.add(dumbbell(#{ center: [-25e-6, 0, 0] }));\ns.add(dumbbell(#{ center: [25e-6, 0, 0], phase: 1.0 }));\n";
 
 #[test]
-fn former_panics_are_values_or_clear_errors() {
+fn oversized_padding_and_spans_are_values_or_clear_errors() {
     case("print(lpad(1, 65536).len());", "65536", 0);
     case("print(rpad(\"D\", 65536).len());", "65536", 0);
     case("lpad(1, 1000000000000);", "SWIMLAB_MAX_STRING", 1);
@@ -43,7 +42,7 @@ fn former_panics_are_values_or_clear_errors() {
 }
 
 #[test]
-fn former_aborts_stop_at_a_named_limit() {
+fn unbounded_arrays_strings_and_recursion_stop_at_a_named_limit() {
     case("uniform_randoms(10000000000, 1);", "SWIMLAB_MAX_ARRAY", 1);
     case(
         "let s = \"ab\";\nfor i in 0..40 { s += s; }",
@@ -54,7 +53,7 @@ fn former_aborts_stop_at_a_named_limit() {
 }
 
 #[test]
-fn former_hangs_are_refused_with_the_numbers() {
+fn runs_that_would_never_end_are_refused_with_the_numbers() {
     let settled = format!("{PAIR}s.run_periods(1);\n");
     case(
         &format!("{settled}s.record([R_H(0)], 5e-324);\ns.run_periods(0);"),

@@ -1,4 +1,4 @@
-//! Issue 48's runs, forces, walls and models: a step that shrinks without end stops with the
+//! Runs, forces, walls and models under bad input: a step that shrinks without end stops with the
 //! reason, positions and the wall are held to the same reach, a model change re-makes the
 //! integrator's choice. Each script case runs in its own `swimlab` process under a time limit,
 //! so a hang fails the test instead of stalling it, and a panic shows as the "internal error"
@@ -123,7 +123,7 @@ fn a_step_beyond_the_reach_of_positions_fails() {
             1,
         );
     }
-    // The issue's case: the first step lands at -7.9e203 m.
+    // A force of 1e200 N: the first step lands at -7.9e203 m.
     case(
         &format!(
             "{ONE}s.integrator = rk4(1e-6);\ns.external_force = [0, 0, -1e200];\ns.run(1e-4);"

@@ -1,4 +1,4 @@
-//! Bulk suspensions of the averaged model (issue 32): neighbour lists against the all-pairs rows
+//! Bulk suspensions of the averaged model: neighbour lists against the all-pairs rows
 //! while swimmers move, cross faces and are relisted; the suspension stepper's order, its
 //! agreement with a tight Dormand-Prince reference, its contacts, guards, interrupts and
 //! save/load mid-run.
@@ -165,7 +165,7 @@ fn run(mut s: Scene, spec: IntegratorSpec, periods: f64) -> Simulation {
 // the tolerance: both lie within 5e-10 of RK4 at T/256, which is itself within RK4's 6.3e-9
 // difference from T/128 there), below 1e-9, well under a tenth of the smallest error compared
 // below (8e-7 at tol 1e-4). At the default tolerance the stepper is within 1e-3 of the RMS
-// displacement (the issue's bar), and the error falls with tol.
+// displacement (the accuracy a suspension study asks), and the error falls with tol.
 #[test]
 fn the_suspension_stepper_converges_to_a_tight_reference() {
     let state = |sim: &Simulation| sim.scene().raw_state().0.to_vec();

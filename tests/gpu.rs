@@ -70,7 +70,7 @@ fn one_step_mismatch(s: &Scene, dt: f64) -> [f64; 2] {
 
 // One RK4 step: both backends evaluate the same formulas in f64 in a different order (pair sums,
 // stage combinations) and with a different sin (a polynomial on the device); the differences are
-// a few ulps of each term, ~1e-15 of the step's change. 1e-12 is the issue's bound.
+// a few ulps of each term, ~1e-15 of the step's change; 1e-12 leaves a thousandfold margin.
 #[test]
 fn one_step_agrees_to_round_off_micro() {
     if !gpu_present("one_step_agrees_to_round_off_micro") {
@@ -122,7 +122,7 @@ fn one_step_agrees_to_round_off_averaged() {
 
 // Fig-1 pair, default RK4 step, 10 periods after one settling period: the drift (~1e-6 ℓ per
 // period) is the difference of two positions ~10ℓ apart, so round-off differences of 1e-16 in
-// the positions appear at ~1e-10 of the drift; 1e-9 is the issue's bound.
+// the positions appear at ~1e-10 of the drift; 1e-9 leaves a tenfold margin.
 #[test]
 fn fig1_drift_over_ten_periods_agrees() {
     if !gpu_present("fig1_drift_over_ten_periods_agrees") {
@@ -298,7 +298,8 @@ fn dopri5_parity(s: &Scene, rtol: f64, duration: f64, bound: f64) -> [f64; 2] {
 
 // Adaptive steps on the device decide accept/reject and the next step as the CPU does (its
 // powers in f64, the guards counted for accepted attempts only); the sums and sin differ by
-// ulps. The issue's bound is 1e-9, with the same steps and rejections. Loose tolerances are the
+// ulps. The drifts agree within 1e-9 (round-off at ~1e-10 of the drift, as above), with the same steps and
+// rejections. Loose tolerances are the
 // hard case: there dopri5 rides the springs' stability limit, rejecting attempts whose states
 // would fail the guards.
 #[test]
@@ -499,7 +500,7 @@ fn bench_scaling_has_gpu_series() {
     );
 }
 
-/// Issue 38: on a machine without a session runtime folder (a server, CI), choosing the GPU
+/// On a machine without a session runtime folder (a server, CI), choosing the GPU
 /// prints nothing but what swimlab says: Mesa's device-selection layer, which would connect to
 /// the Wayland display and have its library print "XDG_RUNTIME_DIR is invalid or not set" twice,
 /// is kept out of the process (the binary, which is what users run).

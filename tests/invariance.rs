@@ -102,7 +102,7 @@ fn mirror_pair_keeps_its_mean_separation() {
 
 #[test]
 fn default_integrator_meets_the_drift_accuracy_budget() {
-    // The requirement: ≤ 1e-4 relative error of the per-period collective drift of the
+    // The default's accuracy contract: ≤ 1e-4 relative error of the per-period collective drift of the
     // Fig-1 pairs at D = 10ℓ, against a converged reference.
     for (n1, n2) in [(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)] {
         for asym in [false, true] {

@@ -23,7 +23,7 @@ fn isolated_asymmetric_dumbbell_returns_each_period() {
     for _ in 0..5 {
         s.run_periods(1.0).unwrap();
         let now = s.center(0).unwrap();
-        // 1e-12 ℓ per period: the bound; the stroke moves R_H by ~1e-3 ℓ within a period.
+        // 1e-12 ℓ per period, a billionth of the ~1e-3 ℓ the stroke moves R_H within a period.
         let moved = (now - previous).norm() / ELL;
         assert!(moved < 1e-12, "R_H moved {moved:e} ell over one period");
         previous = now;

@@ -510,7 +510,7 @@ fn a_changed_scene_gets_a_stepper_of_its_own() {
     assert_eq!(s.raw_state().0, fresh.raw_state().0);
 }
 
-/// Issue 38: the cost of a run follows the motion, not the length. After a run at a loose
+/// The cost of a run follows the motion, not the length. After a run at a loose
 /// tolerance has left the Fig-1 mirror pair at a macro state, a run of 200,000 periods at tol
 /// 1e-8 takes macro steps (17 sample periods). A stage state's springs' lengths are
 /// extrapolated, a little off the slow manifold, and relax within the first sample period;

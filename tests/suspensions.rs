@@ -40,7 +40,7 @@ fn all_finite(s: &Scene) -> bool {
     y.iter().all(|v| v.is_finite())
 }
 
-// Issue 7: a 1,000-swimmer averaged run for a few periods stays finite with the guards on (the
+// A 1,000-swimmer averaged run for a few periods stays finite with the guards on (the
 // default contact guard stops a run cleanly instead; here the steric repulsion keeps swimmers
 // apart, so the run must complete).
 #[test]
@@ -57,7 +57,7 @@ fn thousand_swimmer_averaged_run_stays_finite() {
     );
 }
 
-// Issue 7: a 200-swimmer microscopic run (400 spheres, the fast kernel in parallel) for a few
+// A 200-swimmer microscopic run (400 spheres, the fast kernel in parallel) for a few
 // periods with the default integrator and every guard.
 #[test]
 fn two_hundred_swimmer_micro_run_stays_finite() {

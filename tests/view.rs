@@ -1,4 +1,4 @@
-//! Issue 52, the live view: a scene's frames as the stream serves them while it runs, and the page
+//! The live view: a scene's frames as the stream serves them while it runs, and the page
 //! as a real browser draws it.
 //!
 //! The stream (no browser): every frame shows the scene as it was at the frame's time, to the

@@ -172,6 +172,13 @@ pub fn check_csv_name(path: &Path, what: &str) -> Result<()> {
 /// Create (or truncate) the file `path` for writing, its folder created, with errors that name
 /// the path and the fix.
 pub fn create(path: &Path) -> Result<std::fs::File> {
+    check_target(path)?;
+    std::fs::File::create(path).map_err(|e| write_error(path, e))
+}
+
+/// What a whole-file write to `path` needs first: a name, its folder (created), no folder in its
+/// place, and no writer of this process holding it.
+fn check_target(path: &Path) -> Result<()> {
     if path.as_os_str().is_empty() {
         return Err(invalid!(
             "cannot write a file with an empty name; give a path such as \"out/run.csv\""
@@ -184,10 +191,10 @@ pub fn create(path: &Path) -> Result<std::fs::File> {
             path.display()
         ));
     }
-    if let Some(h) = holder(path) {
-        return Err(held_error(path, &h));
+    match holder(path) {
+        Some(h) => Err(held_error(path, &h)),
+        None => Ok(()),
     }
-    std::fs::File::create(path).map_err(|e| write_error(path, e))
 }
 
 fn write_error(path: &Path, e: std::io::Error) -> super::error::EngineError {
@@ -203,21 +210,7 @@ pub fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
-    if path.as_os_str().is_empty() {
-        return Err(invalid!(
-            "cannot write a file with an empty name; give a path such as \"out/run.csv\""
-        ));
-    }
-    ensure_parent(path)?;
-    if path.is_dir() {
-        return Err(invalid!(
-            "cannot write {}: it is a folder; give a file name",
-            path.display()
-        ));
-    }
-    if let Some(h) = holder(path) {
-        return Err(held_error(path, &h));
-    }
+    check_target(path)?;
     if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
         // A device or pipe (/dev/stdout, a FIFO) is written in place: renaming over it would
         // replace the device node.

@@ -11,7 +11,7 @@ use super::boundary::Boundary;
 use super::contacts::Contacts;
 use super::error::{self, invalid};
 use super::integrators::{
-    noisy_euler, IntegratorSpec, Noise, OdeSystem, Problem, Reach, DEFAULT_AUTO_TOL,
+    noisy_euler, time_scale_of, IntegratorSpec, Noise, OdeSystem, Problem, Reach, DEFAULT_AUTO_TOL,
 };
 use super::mobility::{self_mobility, Mobility};
 use super::model::{
@@ -304,12 +304,7 @@ impl OdeSystem for MicroSystem {
 
     /// The shortest stroke period (0 without swimmers: no scale).
     fn time_scale(&self) -> f64 {
-        let t = shortest_period(&self.swimmers);
-        if t.is_finite() {
-            t
-        } else {
-            0.0
-        }
+        time_scale_of(shortest_period(&self.swimmers))
     }
 
     /// Rejects overlapping spheres, centres beyond the reach, and springs stretched or compressed

@@ -160,7 +160,17 @@ impl Observable {
                 ..
             } => "1/m^3",
             Observable::DeltaDistanceH(..) => "ell",
-            _ => "1",
+            // Dimensionless: unit vectors, phase measures, order parameters, correlations, the
+            // Péclet number, and the fields other than density.
+            Observable::Dir(_)
+            | Observable::Q(..)
+            | Observable::DeltaQ(..)
+            | Observable::Polarization
+            | Observable::Nematic
+            | Observable::OrientationAutocorrelation(_)
+            | Observable::PairCorrelation { .. }
+            | Observable::Peclet(..)
+            | Observable::Field { .. } => "1",
         }
     }
 

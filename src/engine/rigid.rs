@@ -20,7 +20,7 @@ use super::boundary::Boundary;
 use super::contacts::Contacts;
 use super::error::{self, unsupported, EngineError, Setting};
 use super::integrators::{
-    IntegratorSpec, OdeSystem, Problem, Reach, DEFAULT_AUTO_TOL, DEFAULT_RIGID_RTOL,
+    time_scale_of, IntegratorSpec, OdeSystem, Problem, Reach, DEFAULT_AUTO_TOL, DEFAULT_RIGID_RTOL,
 };
 use super::mobility::Mobility;
 use super::model::{
@@ -182,12 +182,7 @@ impl OdeSystem for RigidSystem {
 
     /// The shortest stroke period (0 without swimmers: no scale).
     fn time_scale(&self) -> f64 {
-        let t = shortest_period(&self.swimmers);
-        if t.is_finite() {
-            t
-        } else {
-            0.0
-        }
+        time_scale_of(shortest_period(&self.swimmers))
     }
 
     /// Rejects centres beyond the reach and overlapping spheres.

@@ -2,7 +2,9 @@
 //! error norm, the guards, thermal noise and the projection onto unit orientations.
 
 use super::system::{AveragedSystem, LIST_SWIMMERS, PARALLEL_SWIMMERS};
-use crate::engine::integrators::{GroupJacobian, Noise, OdeSystem, Partitioned, Problem};
+use crate::engine::integrators::{
+    time_scale_of, GroupJacobian, Noise, OdeSystem, Partitioned, Problem,
+};
 use crate::engine::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -51,11 +53,7 @@ impl OdeSystem for AveragedSystem {
     }
 
     fn time_scale(&self) -> f64 {
-        if self.period.is_finite() {
-            self.period
-        } else {
-            0.0
-        }
+        time_scale_of(self.period)
     }
 
     fn stiff_groups(&mut self, _t: f64, y: &[f64]) -> GroupJacobian {

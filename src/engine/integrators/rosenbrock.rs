@@ -34,18 +34,41 @@ pub(super) const G: [[f64; 3]; 4] = [
         5.452_602_553_351_021e-1,
     ],
 ];
-pub(super) const B: [f64; 4] = [
+const B: [f64; 4] = [
     2.421_238_070_609_534_6e-1,
     -1.223_250_583_904_514_7,
     1.545_260_255_335_102,
     4.358_665_215_084_59e-1,
 ];
-pub(super) const B_EMBEDDED: [f64; 4] = [
+const B_EMBEDDED: [f64; 4] = [
     3.781_090_314_581_937e-1,
     -9.604_229_221_242_318e-2,
     0.5,
     2.179_332_607_542_295e-1,
 ];
+/// Stage `i`'s argument y0 + Σ_j A_ij k_j and the Γ-combination Σ_j Γ_ij k_j of the earlier
+/// stages `k`, at component `m` (state `y0` there).
+#[inline]
+pub(super) fn stage_sums(k: &[Vec<f64>; 4], i: usize, y0: f64, m: usize) -> (f64, f64) {
+    let (mut ya, mut ga) = (y0, 0.0);
+    for j in 0..i {
+        ya += A[i][j] * k[j][m];
+        ga += G[i][j] * k[j][m];
+    }
+    (ya, ga)
+}
+
+/// The step's new state and its embedded error estimate at component `m` from the stages `k`.
+#[inline]
+pub(super) fn solution(k: &[Vec<f64>; 4], y0: f64, m: usize) -> (f64, f64) {
+    let (mut y1, mut e) = (y0, 0.0);
+    for i in 0..4 {
+        y1 += B[i] * k[i][m];
+        e += (B[i] - B_EMBEDDED[i]) * k[i][m];
+    }
+    (y1, e)
+}
+
 /// Adaptive ROS34PW2 with relative tolerance `rtol` (against [`OdeSystem::error_scale`]), or with
 /// fixed steps for convergence studies.
 #[derive(Debug, Clone)]
@@ -114,14 +137,7 @@ impl Rosenbrock {
         for i in 0..4 {
             // Stage argument and Γ-combination of the earlier stages.
             for m in 0..n {
-                let mut ya = y[m];
-                let mut ga = 0.0;
-                for j in 0..i {
-                    ya += A[i][j] * self.k[j][m];
-                    ga += G[i][j] * self.k[j][m];
-                }
-                self.tmp[m] = ya;
-                self.acc[m] = ga;
+                (self.tmp[m], self.acc[m]) = stage_sums(&self.k, i, y[m], m);
             }
             if i == 0 {
                 self.f.copy_from_slice(&self.f0);
@@ -154,13 +170,8 @@ impl Rosenbrock {
         }
         let mut err = 0.0;
         for m in 0..n {
-            let mut ynew = y[m];
-            let mut e = 0.0;
-            for i in 0..4 {
-                ynew += B[i] * self.k[i][m];
-                e += (B[i] - B_EMBEDDED[i]) * self.k[i][m];
-            }
-            self.y_new[m] = ynew;
+            let e;
+            (self.y_new[m], e) = solution(&self.k, y[m], m);
             let r = e / (self.rtol * self.scale[m]);
             err += r * r;
         }

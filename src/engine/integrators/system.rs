@@ -484,6 +484,16 @@ pub(crate) fn check_state(sys: &mut dyn OdeSystem, t: f64, y: &[f64]) -> Result<
 /// this, consecutive steps or due times can no longer be told apart in f64.
 pub const MIN_RELATIVE_INTERVAL: f64 = 1e-12;
 
+/// [`OdeSystem::time_scale`] of a system whose dynamics unfold on `period` (s): the period, or 0
+/// (no scale: steps held to t alone) where it is not finite, as a scene without swimmers has it.
+pub fn time_scale_of(period: f64) -> f64 {
+    if period.is_finite() {
+        period
+    } else {
+        0.0
+    }
+}
+
 /// Refuse an interval `dt` (s) that f64 cannot tell apart at times of size `scale` (s): below
 /// [`MIN_RELATIVE_INTERVAL`] of them, consecutive due times or steps round to the same time.
 /// `what` names the interval (with its value) in the message, `fix` says what to change.

@@ -4,7 +4,7 @@
 use super::refine::{Access, Refusal};
 use super::scratch::Refinement;
 use super::stepper::Suspension;
-use crate::engine::integrators::rosenbrock::{A, B, B_EMBEDDED, G, GAMMA};
+use crate::engine::integrators::rosenbrock::{solution, stage_sums, A, G, GAMMA};
 use crate::engine::integrators::system::{GroupJacobian, OdeSystem, Stats};
 
 impl Suspension {
@@ -121,26 +121,4 @@ impl Suspension {
         let sum: f64 = bodies.iter().map(|&b| sub.errors[b] * sub.errors[b]).sum();
         Ok((sum / bodies.len().max(1) as f64).sqrt())
     }
-}
-/// Stage `i`'s argument y0 + Σ_j A_ij k_j and the Γ-combination Σ_j Γ_ij k_j of the earlier
-/// stages `k`, at component `m` (state `y0` there).
-#[inline]
-pub(super) fn stage_sums(k: &[Vec<f64>; 4], i: usize, y0: f64, m: usize) -> (f64, f64) {
-    let (mut ya, mut ga) = (y0, 0.0);
-    for j in 0..i {
-        ya += A[i][j] * k[j][m];
-        ga += G[i][j] * k[j][m];
-    }
-    (ya, ga)
-}
-
-/// The step's new state and its embedded error estimate at component `m` from the stages `k`.
-#[inline]
-pub(super) fn solution(k: &[Vec<f64>; 4], y0: f64, m: usize) -> (f64, f64) {
-    let (mut y1, mut e) = (y0, 0.0);
-    for i in 0..4 {
-        y1 += B[i] * k[i][m];
-        e += (B[i] - B_EMBEDDED[i]) * k[i][m];
-    }
-    (y1, e)
 }
