@@ -41,6 +41,7 @@ pub mod periodic;
 pub mod plan;
 pub(crate) mod recorder;
 pub mod rigid;
+pub mod rng;
 pub(crate) mod scene;
 pub(crate) mod simd;
 pub(crate) mod simulation;

@@ -97,13 +97,8 @@ mod tests {
         let mu = 1e-3;
         for n in [6, FAST_KERNEL_SPHERES + 10] {
             let mut op = OpenSpace::new(mu, Mobility::Rpy);
-            let mut seed = 0x9e3779b97f4a7c15u64;
-            let mut next = || {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
-                (seed >> 11) as f64 / (1u64 << 53) as f64
-            };
+            let mut rng = crate::engine::rng::Rng::new(0x9e3779b97f4a7c15);
+            let mut next = || rng.uniform();
             let pos: Vec<Vector3<f64>> = (0..n)
                 .map(|_| Vector3::new(next(), next(), next()) * 40e-6)
                 .collect();

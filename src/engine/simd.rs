@@ -167,12 +167,10 @@ mod tests {
                 return;
             }
             let mut worst = 0.0f64;
-            let mut state = 0x9e37_79b9_7f4a_7c15u64;
+            let mut rng = crate::engine::rng::Rng::new(0x9e37_79b9_7f4a_7c15);
             for _ in 0..20_000 {
                 let x: [f64; LANES] = std::array::from_fn(|_| {
-                    state ^= state << 13;
-                    state ^= state >> 7;
-                    state ^= state << 17;
+                    let state = rng.next_u64();
                     let mantissa = 1.0 + (state >> 11) as f64 / (1u64 << 53) as f64;
                     mantissa * 10f64.powi((state % 600) as i32 - 300)
                 });

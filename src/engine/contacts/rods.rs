@@ -326,13 +326,8 @@ mod tests {
     #[test]
     fn the_bounding_test_skips_only_pairs_out_of_reach() {
         use super::super::steric::StericLaw;
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut draw = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::engine::rng::Rng::new(0x9e37_79b9_7f4a_7c15);
+        let mut draw = || rng.uniform();
         fn unit(draw: &mut dyn FnMut() -> f64) -> Vector3<f64> {
             let z: f64 = 2.0 * draw() - 1.0;
             let phi = 2.0 * std::f64::consts::PI * draw();

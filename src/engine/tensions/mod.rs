@@ -412,13 +412,14 @@ mod tests {
     use crate::engine::ewald::Ewald;
     use crate::engine::mobility::Mobility;
     use crate::engine::periodic::PeriodicBox;
+    use crate::engine::rng::Rng;
 
     /// The product from K's lower part equals the full matrix's, whatever lies above the
     /// diagonal, serially and in runs of columns (two runs at 600 rows, three at 700): to the
     /// rounding of sums of a few hundred terms of either sign.
     #[test]
     fn the_lower_product_is_the_symmetric_matrix_applied() {
-        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let mut rng = Rng::new(0x2545_f491_4f6c_dd1d);
         for count in [1, 7, 8, 9, 300, 600, 700] {
             let mut k = DMatrix::from_fn(count, count, |_, _| rng.uniform() - 0.5);
             k = &k + k.transpose();
@@ -448,25 +449,6 @@ mod tests {
         assert!((b - x).amax() < 1e-14);
     }
 
-    /// A small generator of uniform numbers in [0, 1) (xorshift).
-    struct Rng(u64);
-
-    impl Rng {
-        fn uniform(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-
-        fn unit_vector(&mut self) -> Vector3<f64> {
-            let z = 2.0 * self.uniform() - 1.0;
-            let phi = 2.0 * std::f64::consts::PI * self.uniform();
-            let rho = (1.0 - z * z).sqrt();
-            Vector3::new(rho * phi.cos(), rho * phi.sin(), z)
-        }
-    }
-
     /// `count` asymmetric dumbbells at random in a cube of side `side` (spheres may come close:
     /// the test wants off-diagonal weight), with their orientations and stroke rates.
     fn dumbbells(
@@ -474,7 +456,7 @@ mod tests {
         side: f64,
         mobility: Mobility,
     ) -> (Spheres, Vec<Dumbbell>, Vec<Vector3<f64>>, DVector<f64>) {
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut rng = Rng::new(0x9e37_79b9_7f4a_7c15);
         let mut d = Dumbbell::default();
         (d.a1, d.a2) = (0.225 * d.ell, 0.1125 * d.ell);
         let swimmers: Vec<Dumbbell> = (0..count)

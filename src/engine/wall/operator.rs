@@ -406,13 +406,8 @@ mod tests {
     fn product_equals_the_matrix_minus_drag() {
         let mu = 1e-3;
         let z0 = -2e-6;
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::engine::rng::Rng::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.uniform();
         let sizes = [
             5,
             13,
@@ -499,13 +494,8 @@ mod tests {
     fn the_divergence_is_its_definition() {
         let mu = 1e-3;
         let z0 = 1e-6;
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::engine::rng::Rng::new(0x2545_f491_4f6c_dd1d);
+        let mut next = || rng.uniform();
         for kind in [Mobility::Rpy, Mobility::Oseen] {
             for n in [6, PARALLEL_IMAGE_SPHERES + 7] {
                 let op = WallMobility::new(mu, kind, Wall::at(z0).expect("a finite wall"));
