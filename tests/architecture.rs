@@ -308,3 +308,56 @@ fn the_repl_reaches_the_engine_through_the_script_layer() {
         "the REPL imports the engine directly in {reaching:?}"
     );
 }
+
+/// A boundary's kind-specific rules live in `engine/boundary/`: no code elsewhere tells the kinds
+/// apart by matching `Boundary`'s variants (a `match` arm, `if let`, `matches!`), so that a new
+/// kind is one file and one arm there. Building a boundary value (`Boundary::Open`) is not a match.
+#[test]
+fn boundary_kinds_are_matched_only_in_the_boundary_folder() {
+    let variant = |s: &str, at: usize| {
+        ["Boundary::Open", "Boundary::Periodic", "Boundary::Wall"]
+            .iter()
+            .any(|v| s[at..].starts_with(v))
+    };
+    let mut found = Vec::new();
+    let mut stack = vec![Path::new(ROOT).join("src")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap().flatten() {
+            let p = entry.path();
+            if p.is_dir() {
+                if !p.ends_with("engine/boundary") {
+                    stack.push(p);
+                }
+                continue;
+            }
+            if p.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&p).unwrap();
+            for (k, line) in text.lines().enumerate() {
+                let code = line.split("//").next().unwrap_or("");
+                for (at, _) in code.match_indices("Boundary::") {
+                    if !variant(code, at) {
+                        continue;
+                    }
+                    let before = code[..at].trim_end();
+                    let rest = &code[at..];
+                    let arm = rest.contains("=>") && !rest.contains("=> Boundary::");
+                    if arm
+                        || before.ends_with("if let")
+                        || before.ends_with("while let")
+                        || before.ends_with('|')
+                        || before.contains("matches!(")
+                    {
+                        found.push(format!("{}:{}: {}", p.display(), k + 1, line.trim()));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "Boundary matched outside engine/boundary/:\n{}",
+        found.join("\n")
+    );
+}

@@ -80,7 +80,34 @@ pub struct MobilitySettings {
 
 /// What a boundary means for the spheres in it, each kind answering for itself: the defaults
 /// are open space's (no images, nothing solid, nothing to fit).
+/// How a pair of swimmers' terms of the rigid model's constraint matrix K come from closed-form
+/// pair coefficients in a boundary (the tensions' fill): each kind says, so that a new kind
+/// cannot be routed to another's fill without a word.
+#[derive(Debug, Clone, Copy)]
+pub enum PairTerms {
+    /// Exactly: open space's pair tensor.
+    Open,
+    /// Exactly: open space's pair tensor and the wall's image terms, of the spheres lifted and
+    /// damped as the wall's mobility takes them ([`Wall::lift`]).
+    Wall(Wall),
+    /// Not exactly (the box's pair terms are whole Ewald sums): open space's at the minimum
+    /// images, a preconditioner for an iteration over the box's mobility products.
+    MinimumImages(PeriodicBox),
+}
+
+impl PairTerms {
+    /// Whether the pair coefficients give K itself (else only its approximation).
+    pub fn exact(&self) -> bool {
+        !matches!(self, PairTerms::MinimumImages(_))
+    }
+}
+
 pub trait Geometry: std::fmt::Debug + Send + Sync {
+    // ----- the rigid model's constraint matrix ---------------------------------------------
+
+    /// How K's pair terms come from pair coefficients here ([`PairTerms`]).
+    fn pair_terms(&self) -> PairTerms;
+
     // ----- minimum images ------------------------------------------------------------------
 
     /// The periodic box whose minimum images separations take; `None` where separations are

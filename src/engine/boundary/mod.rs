@@ -21,6 +21,6 @@ mod open;
 mod periodic;
 mod wall;
 
-pub use geometry::{Extent, Geometry, MobilitySettings, MAX_EXTENT_IN_RADII};
+pub use geometry::{Extent, Geometry, MobilitySettings, PairTerms, MAX_EXTENT_IN_RADII};
 pub use kinds::{Boundary, Kind};
 pub use periodic::ewald;

@@ -1,7 +1,7 @@
 //! Open space: the unbounded fluid, with no images, nothing solid and nothing to fit (the
 //! [`Geometry`] defaults), and the RPY or Oseen pairs of [`OpenSpace`] as its mobility.
 
-use super::geometry::{Geometry, MobilitySettings};
+use super::geometry::{Geometry, MobilitySettings, PairTerms};
 use crate::engine::error::Result;
 use crate::engine::mobility::MobilityOperator;
 use crate::engine::open_space::OpenSpace;
@@ -11,6 +11,10 @@ use crate::engine::open_space::OpenSpace;
 pub struct OpenFluid;
 
 impl Geometry for OpenFluid {
+    fn pair_terms(&self) -> PairTerms {
+        PairTerms::Open
+    }
+
     fn mobility(&self, settings: &MobilitySettings) -> Result<Box<dyn MobilityOperator>> {
         Ok(Box::new(OpenSpace::new(settings.mu, settings.kind)))
     }

@@ -1,7 +1,7 @@
 //! A periodic box's geometry: minimum images, wrapping for what is shown, a swimmer that must
 //! not meet its own image, sides within the extent, and Ewald sums as its mobility.
 
-use super::geometry::{Extent, Geometry, MobilitySettings, MAX_EXTENT_IN_RADII};
+use super::geometry::{Extent, Geometry, MobilitySettings, PairTerms, MAX_EXTENT_IN_RADII};
 use crate::engine::error::{invalid, short, Result};
 use crate::engine::ewald::Ewald;
 use crate::engine::mobility::MobilityOperator;
@@ -24,6 +24,10 @@ pub fn ewald(b: &PeriodicBox, settings: &MobilitySettings) -> Result<Ewald> {
 }
 
 impl Geometry for PeriodicBox {
+    fn pair_terms(&self) -> PairTerms {
+        PairTerms::MinimumImages(*self)
+    }
+
     fn periodic(&self) -> Option<&PeriodicBox> {
         Some(self)
     }

@@ -2,7 +2,7 @@
 //! report of a sphere that touched it, the checks that spheres lie above it), its height within
 //! the extent, and the Rotne-Prager-Blake mobility of [`WallMobility`].
 
-use super::geometry::{Extent, Geometry, MobilitySettings};
+use super::geometry::{Extent, Geometry, MobilitySettings, PairTerms};
 use crate::engine::error::{invalid, unsupported, Result, Setting};
 use crate::engine::integrators::Problem;
 use crate::engine::mobility::MobilityOperator;
@@ -10,6 +10,10 @@ use crate::engine::wall::{Wall, WallMobility};
 use nalgebra::Vector3;
 
 impl Geometry for Wall {
+    fn pair_terms(&self) -> PairTerms {
+        PairTerms::Wall(*self)
+    }
+
     fn solid(&self) -> bool {
         true
     }

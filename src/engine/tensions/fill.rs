@@ -2,12 +2,13 @@
 //! from the pair coefficients in vector lanes, its part on and below the diagonal (open space,
 //! a box's minimum images for the preconditioner, and above a wall with the image's terms).
 
+use crate::engine::boundary::PairTerms;
 use crate::engine::mobility::{self_mobility, Mobility};
 use crate::engine::parallel::{PARALLEL_IMAGE_SPHERES, PARALLEL_SPHERES};
-use crate::engine::periodic::{separation, PeriodicBox};
+use crate::engine::periodic::separation;
 use crate::engine::simd::vector_dispatch;
 use crate::engine::spheres::Spheres;
-use crate::engine::wall::{image_coefficients, Wall};
+use crate::engine::wall::image_coefficients;
 use nalgebra::{DMatrix, Vector3};
 use rayon::prelude::*;
 
@@ -27,30 +28,6 @@ pub(super) fn fill_blocks(spheres: &Spheres, n: &[Vector3<f64>], k: &mut DMatrix
             let v = k_entry(spheres, n, sg, tau);
             k[(sg, tau)] = v;
             k[(tau, sg)] = v;
-        }
-    }
-}
-
-/// Where the pairs of a K filled from pair coefficients lie.
-#[derive(Debug, Clone, Copy)]
-pub(super) enum Fill<'a> {
-    /// Open space.
-    Open,
-    /// Open space at the box's minimum images (the preconditioner of a box's iteration).
-    MinimumImages(&'a PeriodicBox),
-    /// Above a wall: open space's pairs and the wall's image terms, of the spheres lifted and
-    /// damped as the wall's mobility takes them ([`Wall::lift`]).
-    Wall(&'a Wall),
-}
-
-impl<'a> Fill<'a> {
-    /// A box's minimum images where there is a box, else the wall where there is one, else open
-    /// space.
-    pub(super) fn of(periodic: Option<&'a PeriodicBox>, wall: Option<&'a Wall>) -> Self {
-        match (periodic, wall) {
-            (Some(b), _) => Fill::MinimumImages(b),
-            (None, Some(w)) => Fill::Wall(w),
-            (None, None) => Fill::Open,
         }
     }
 }
@@ -183,9 +160,14 @@ vector_dispatch! {
 /// wall N_σ·W N_τ, damped). Column by column in vector lanes (in parallel for many spheres); the
 /// diagonal and any entry with overlapping spheres again exactly: by the pair coefficients, and
 /// above a wall by the wall mobility's own blocks.
-pub(super) fn fill_pairs(spheres: &Spheres, n: &[Vector3<f64>], fill: Fill, k: &mut DMatrix<f64>) {
+pub(super) fn fill_pairs(
+    spheres: &Spheres,
+    n: &[Vector3<f64>],
+    fill: &PairTerms,
+    k: &mut DMatrix<f64>,
+) {
     let periodic = match fill {
-        Fill::MinimumImages(b) => Some(b),
+        PairTerms::MinimumImages(b) => Some(b),
         _ => None,
     };
     let l = periodic.map_or([0.0; 3], |b| b.sides());
@@ -198,7 +180,7 @@ pub(super) fn fill_pairs(spheres: &Spheres, n: &[Vector3<f64>], fill: Fill, k: &
         .iter()
         .zip(radii)
         .map(|(x, &a)| match fill {
-            Fill::Wall(w) => w.lift(x, a),
+            PairTerms::Wall(w) => w.lift(x, a),
             _ => (*x, 1.0),
         })
         .collect();
@@ -226,7 +208,7 @@ pub(super) fn fill_pairs(spheres: &Spheres, n: &[Vector3<f64>], fill: Fill, k: &
     // images for its preconditioner; the box's own blocks are whole Ewald sums), and above a wall
     // the wall mobility's own blocks.
     let exact = |sg: usize, tau: usize| {
-        if let Fill::Wall(_) = fill {
+        if let PairTerms::Wall(_) = fill {
             return k_entry(spheres, n, sg, tau);
         }
         let (ns, nt) = (n[sg], n[tau]);
@@ -247,7 +229,7 @@ pub(super) fn fill_pairs(spheres: &Spheres, n: &[Vector3<f64>], fill: Fill, k: &
         }
         sum
     };
-    let wall = matches!(fill, Fill::Wall(_));
+    let wall = matches!(fill, PairTerms::Wall(_));
     // Only the part on and below the diagonal: K is symmetric, and its products read that part
     // alone ([`lower_mul_to`]).
     let column = |tau: usize, col: &mut [f64], margin: &mut Vec<f64>| {

@@ -32,15 +32,13 @@ mod earlier;
 mod fill;
 mod lower;
 
-use super::boundary::Boundary;
+use super::boundary::{Boundary, PairTerms};
 use super::cg::{cg, CgVectors};
 use super::mobility::self_mobility;
-use super::periodic::PeriodicBox;
 use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
-use super::wall::Wall;
 use earlier::Earlier;
-use fill::{fill_blocks, fill_pairs, Fill};
+use fill::{fill_blocks, fill_pairs};
 use lower::lower_mul_to;
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -100,13 +98,17 @@ pub enum Route {
 }
 
 impl Route {
-    /// The route for `swimmers` dumbbells in `boundary`.
+    /// The route for `swimmers` dumbbells in `boundary`: over its mobility products where its
+    /// pair coefficients do not give K exactly ([`PairTerms::exact`]) or K is too large to hold.
     pub fn for_scene(boundary: &Boundary, swimmers: usize) -> Self {
-        match boundary {
-            Boundary::Periodic(_) => Route::Products,
-            _ if swimmers <= ELIMINATE_UP_TO => Route::Eliminate,
-            _ if swimmers > DENSE_MATRIX_UP_TO => Route::Products,
-            Boundary::Open | Boundary::Wall(_) => Route::Pairs,
+        if !boundary.geometry().pair_terms().exact() {
+            Route::Products
+        } else if swimmers <= ELIMINATE_UP_TO {
+            Route::Eliminate
+        } else if swimmers > DENSE_MATRIX_UP_TO {
+            Route::Products
+        } else {
+            Route::Pairs
         }
     }
 }
@@ -125,10 +127,10 @@ pub struct Tensions {
     diag: DVector<f64>,
     /// The iteration's vectors.
     outer: CgVectors,
-    /// The box, whose minimum images the open-space K of the preconditioner takes.
-    periodic: Option<PeriodicBox>,
-    /// The wall, whose image terms K filled from pairs takes.
-    wall: Option<Wall>,
+    /// How K's pair terms come from pair coefficients in the boundary: K itself on the pairs'
+    /// route (open space, a wall's images), the preconditioner's on the products' (a box's
+    /// minimum images).
+    terms: PairTerms,
     /// Whether the products' iteration is preconditioned by open space's K (held in `k`),
     /// solved on the matrix, instead of the diagonal.
     near: bool,
@@ -145,13 +147,10 @@ pub struct Tensions {
 impl Tensions {
     /// A solver for `swimmers` dumbbells in `boundary`.
     pub fn new(boundary: &Boundary, swimmers: usize) -> Self {
-        let mut t = Self::by(Route::for_scene(boundary, swimmers), swimmers);
-        match boundary {
-            Boundary::Periodic(b) => t.periodic = Some(*b),
-            Boundary::Wall(w) => t.wall = Some(*w),
-            Boundary::Open => {}
+        Tensions {
+            terms: boundary.geometry().pair_terms(),
+            ..Self::by(Route::for_scene(boundary, swimmers), swimmers)
         }
-        t
     }
 
     /// A solver for `swimmers` dumbbells that takes `route`.
@@ -173,8 +172,7 @@ impl Tensions {
             velocities: vec![0.0; 6 * swimmers],
             diag: zeros(),
             outer: CgVectors::zeros(swimmers),
-            periodic: None,
-            wall: None,
+            terms: PairTerms::Open,
             near,
             inner_x: zeros(),
             inner: CgVectors::zeros(swimmers),
@@ -223,13 +221,12 @@ impl Tensions {
         let solved = match self.route {
             Route::Eliminate => false,
             Route::Pairs => {
-                fill_pairs(spheres, n, Fill::of(None, self.wall.as_ref()), &mut self.k);
+                fill_pairs(spheres, n, &self.terms, &mut self.k);
                 self.iterate(spheres, swimmers, n, t, rate)
             }
             Route::Products => {
                 if self.near {
-                    let fill = Fill::of(self.periodic.as_ref(), None);
-                    fill_pairs(spheres, n, fill, &mut self.k);
+                    fill_pairs(spheres, n, &self.terms, &mut self.k);
                 }
                 self.iterate(spheres, swimmers, n, t, rate)
             }
