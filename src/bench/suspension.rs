@@ -10,7 +10,7 @@
 
 use super::table::Table;
 use crate::engine::build::{
-    box_side, lattice_scene_of, random_suspension_apart, Orientations, Phases,
+    box_side, lattice_scene_of, random_suspension_apart, Draw, Orientations, Phases,
 };
 use crate::engine::error::Result;
 use crate::engine::integrators::OdeSystem;
@@ -57,10 +57,12 @@ pub fn bulk_scene_apart(
         n,
         d,
         [side; 3],
-        Orientations::Random,
-        Phases::Random,
-        seed,
-        gap,
+        Draw {
+            orientations: Orientations::Random,
+            phases: Phases::Random,
+            seed,
+            gap,
+        },
     )?;
     s.set_cutoff(Some(CUTOFF_ELLS * d.ell))?;
     s.set_steric(Some(steric()?));

@@ -54,23 +54,39 @@ pub fn random_suspension(
     phases: Phases,
     seed: u64,
 ) -> Result<()> {
-    random_suspension_apart(scene, n, d, sides, orientations, phases, seed, None)
+    let draw = Draw {
+        orientations,
+        phases,
+        seed,
+        gap: None,
+    };
+    random_suspension_apart(scene, n, d, sides, draw)
 }
 
-/// [`random_suspension`] with every sphere gap above `gap` (m) if given, instead of the default
-/// 4λ·max(w1, w2) the strokes can close. Each candidate is tested against the spheres in the cells
-/// around its own (cells as wide as the widest conflict, 2·largest radius + gap): O(1) per
-/// candidate, so placement is O(n).
-#[allow(clippy::too_many_arguments)]
+/// How a random suspension is drawn: its orientations and phases, the generator's seed, and the
+/// smallest sphere gap at placement (m; `None`: the 4λ·max(w1, w2) the strokes can close).
+#[derive(Debug, Clone, Copy)]
+pub struct Draw {
+    /// The swimmers' orientations.
+    pub orientations: Orientations,
+    /// Their stroke phases.
+    pub phases: Phases,
+    /// The generator's seed.
+    pub seed: u64,
+    /// The smallest sphere gap, if not the default.
+    pub gap: Option<f64>,
+}
+
+/// [`random_suspension`] as `draw` says, every sphere gap above its `gap` (m) if given, instead of
+/// the default 4λ·max(w1, w2) the strokes can close. Each candidate is tested against the spheres
+/// in the cells around its own (cells as wide as the widest conflict, 2·largest radius + gap):
+/// O(1) per candidate, so placement is O(n).
 pub fn random_suspension_apart(
     scene: &mut Scene,
     n: usize,
     d: Dumbbell,
     sides: [f64; 3],
-    orientations: Orientations,
-    phases: Phases,
-    seed: u64,
-    gap: Option<f64>,
+    draw: Draw,
 ) -> Result<()> {
     // No swimmers need no room (a volume fraction gives them a cube of side 0).
     if n == 0 {
@@ -80,6 +96,12 @@ pub fn random_suspension_apart(
         require_positive("box side", side, "m")?;
     }
     scene.check_region_reach(&d, sides)?;
+    let Draw {
+        orientations,
+        phases,
+        seed,
+        gap,
+    } = draw;
     place_in(scene, n, d, seed, gap, Some(sides), |rng| {
         let u = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()).add_scalar(-0.5);
         let c = u.component_mul(&Vector3::from(sides));

@@ -272,7 +272,7 @@ fn add_random(
     seed: INT,
     opts: &rhai::Map,
 ) -> ScriptResult<INT> {
-    use crate::engine::build::{box_side, random_suspension_apart, Orientations, Phases};
+    use crate::engine::build::{box_side, random_suspension_apart, Draw, Orientations, Phases};
     if n < 0 {
         return Err(script_error(format!(
             "add_random: the number of swimmers must be >= 0, got {n}"
@@ -318,10 +318,12 @@ fn add_random(
         n as usize,
         d.params,
         sides,
-        orientations,
-        phases,
-        seed as u64,
-        gap,
+        Draw {
+            orientations,
+            phases,
+            seed: seed as u64,
+            gap,
+        },
     ))?;
     s.replace(trial)
 }

@@ -16,7 +16,6 @@ use nalgebra::Vector3;
 
 /// One partner's terms added to the row's accumulators: the row at `at` with orientation `n` and
 /// prefactors `k`, the partner at (x, y, z) with orientation (bx, by, bz) and phase sine `sin`.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn list_term<const IK: bool>(
     at: &[f64; 3],

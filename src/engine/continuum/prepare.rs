@@ -60,7 +60,6 @@ impl Continuum {
     /// Refused, the state unchanged: a population that does not exist, mode 0 (the mean, which
     /// would change the conserved numbers), a mode the grid does not hold, an amplitude that would
     /// make f negative somewhere ([`largest_amplitude`]).
-    #[allow(clippy::too_many_arguments)]
     pub fn perturb(
         &mut self,
         base: &BaseState,

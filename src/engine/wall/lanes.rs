@@ -180,7 +180,6 @@ pub(crate) fn image_coefficients(
 /// force `f`, with `q` = 1/r, r = |x_i − x_j*|: W_ij F_j = (A f_∥ + R_∥ (B R_∥·f_∥ + C f_z),
 /// D R_∥·f_∥ + E f_z) and W_ijᵀ F_i = (A f_∥ + R_∥ (B R_∥·f_∥ + D f_z), C R_∥·f_∥ + E f_z)
 /// ([`image_coefficients`]).
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn pair_terms(
     p: &Row,
