@@ -3,7 +3,7 @@
 
 use super::kernel::Constants;
 use super::operator::{Kinetic, Operator};
-use super::spec::{deposit, populations, ContinuumSpec, Lengths};
+use super::spec::{deposit, populations, ContinuumSpec, Lengths, Particles};
 use super::state::Continuum;
 use crate::engine::averaged::pair_constants;
 use crate::engine::error::{invalid, Result};
@@ -101,9 +101,12 @@ impl Continuum {
         let dirs: Vec<_> = (0..scene.count())
             .map(|i| scene.dir(i))
             .collect::<Result<_>>()?;
-        deposit(
-            &op, spec.grid, sides, width, &centres, &dirs, &member, &mut state,
-        );
+        let particles = Particles {
+            centres: &centres,
+            dirs: &dirs,
+            member: &member,
+        };
+        deposit(&op, spec.grid, sides, width, &particles, &mut state);
         let kinetic = Kinetic {
             pops: pops.len(),
             op: Arc::new(op),

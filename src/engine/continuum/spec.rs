@@ -252,26 +252,36 @@ pub(super) fn populations(
     Ok((pops, member))
 }
 
+/// The swimmers a continuum's state is deposited from: centres (shown in the box), orientations,
+/// and the population of each.
+pub(super) struct Particles<'a> {
+    pub(super) centres: &'a [nalgebra::Vector3<f64>],
+    pub(super) dirs: &'a [nalgebra::Vector3<f64>],
+    pub(super) member: &'a [usize],
+}
+
 /// Spread every swimmer over the grid (the Gaussian of `scene.field`) into its population's
 /// coefficients: c_{p,i}(x) = Σ_{σ∈p} Y_i(N_σ) K_σ(x), the projection of the particles' smoothed
 /// distribution on the basis.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn deposit(
     op: &Operator,
     grid: [usize; 3],
     sides: [f64; 3],
     width: f64,
-    centres: &[nalgebra::Vector3<f64>],
-    dirs: &[nalgebra::Vector3<f64>],
-    member: &[usize],
+    particles: &Particles,
     state: &mut [f64],
 ) {
+    let Particles {
+        centres,
+        dirs,
+        member,
+    } = particles;
     let h: [f64; 3] = std::array::from_fn(|d| sides[d] / grid[d] as f64);
     let origin: [f64; 3] = std::array::from_fn(|d| -0.5 * sides[d] + 0.5 * h[d]);
     let dv = h[0] * h[1] * h[2];
     let b = op.sphere.len();
     let cells = op.cells;
-    for ((c, dir), &p) in centres.iter().zip(dirs).zip(member) {
+    for ((c, dir), &p) in centres.iter().zip(dirs.iter()).zip(member.iter()) {
         let axes: [Vec<(usize, f64)>; 3] = std::array::from_fn(|d| {
             gaussian_axis(c[d], h[d], origin[d], width, grid[d], Some(sides[d]))
         });
