@@ -3,7 +3,7 @@
 //! controller sizes the next step by.
 
 use super::refine::{closure, groups_of, Refusal};
-use super::scratch::Rounds;
+use super::scratch::{Coarse, Rounds};
 use super::stepper::Suspension;
 use crate::engine::integrators::system::{GroupJacobian, OdeSystem, Stats};
 
@@ -90,6 +90,13 @@ impl Suspension {
         // neighbour's read error only its refined partners' paths, so both stand until the
         // refined swimmers around them change.
         let mut kept = Rounds::default();
+        let step = Coarse {
+            t,
+            h,
+            y,
+            end: &coarse,
+            floor: &floor,
+        };
         for _ in 0..RING_ROUNDS {
             // Swimmers that read none of each other's states take their own steps.
             self.prepare_sub(y, n);
@@ -98,7 +105,7 @@ impl Suspension {
             // A contact forming between a group and a swimmer outside it: both join the refined
             // swimmers and the round is taken again.
             let groups = groups_of(p, &refined);
-            match self.refine_groups(p, t, h, y, &coarse, &groups, &floor, &mut kept) {
+            match self.refine_groups(p, &step, &groups, &mut kept) {
                 Ok(taken) => steps = taken,
                 Err(Refusal::Crossing(more)) => {
                     refined = closure(refined.into_iter().chain(more).collect(), jac, bs);
@@ -106,13 +113,13 @@ impl Suspension {
                 }
                 Err(_) => return (f64::INFINITY, false),
             }
-            ring = self.ring_of(p, h, y, &coarse, &refined, &e, &floor, jac, &mut kept);
+            ring = self.ring_of(p, &step, &refined, &e, jac, &mut kept);
             if refined.len() + ring.len() > most.max(1) * 8 {
                 // Stepping again a ring this large costs more than a shorter step for all: the
                 // step the fast swimmers need unrefined.
                 return (worst, false);
             }
-            let missed = self.redo_ring(p, t, h, y, &refined, &ring, &floor, &mut kept);
+            let missed = self.redo_ring(p, &step, &refined, &ring, &mut kept);
             if missed.is_empty() {
                 settled = true;
                 break;

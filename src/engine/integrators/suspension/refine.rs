@@ -3,7 +3,7 @@
 //! others from the coarse step; groups that read none of each other apart, on rayon's threads
 //! when the system allows (see the module docs of [`super`]).
 
-use super::scratch::{Path, Refined, Refinement, Rounds};
+use super::scratch::{Coarse, Path, Refined, Refinement, Rounds};
 use super::stepper::Suspension;
 use crate::engine::integrators::controller::{step_too_small, StepRule};
 use crate::engine::integrators::system::{GroupJacobian, Partitioned};
@@ -95,19 +95,21 @@ impl Suspension {
     /// Step the swimmers `bodies` again from `t` to `t + h` by steps of their own (scratch
     /// `sub`), the others read from the coarse step (`coarse`, with rates `f0` at its start):
     /// their components, path across the step and the steps taken.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn refine(
         sub: &mut Refinement,
         p: &mut Access,
         tol: f64,
-        t: f64,
-        h: f64,
-        y: &[f64],
-        coarse: &[f64],
+        step: &Coarse,
         f0: &[f64],
         bodies: &[usize],
-        floor: &[f64],
     ) -> Result<Refined, Refusal> {
+        let Coarse {
+            t,
+            h,
+            y,
+            end: coarse,
+            floor,
+        } = *step;
         let bs = p.get().body_size();
         let mut partners = Vec::new();
         p.get().partners(bodies, &mut partners);
@@ -169,16 +171,11 @@ impl Suspension {
     /// group otherwise, on this thread. Their new states go into `y_new` and their paths into
     /// `self.paths`, the swimmers of the groups refined now added to `kept.changed`; the steps taken,
     /// or the refusal of the first group refused.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn refine_groups(
         &mut self,
         p: &mut dyn Partitioned,
-        t: f64,
-        h: f64,
-        y: &[f64],
-        coarse: &[f64],
+        step: &Coarse,
         groups: &[Vec<usize>],
-        floor: &[f64],
         kept: &mut Rounds,
     ) -> Result<u64, Refusal> {
         let (tol, f0) = (self.tol, &self.f0);
@@ -191,54 +188,34 @@ impl Suspension {
             changed.sort_unstable();
             changed.dedup();
         }
-        let mut results: Vec<Result<Refined, Refusal>> =
-            if new.len() >= PARALLEL_GROUPS && p.shares_rates() {
-                let shared: &dyn Partitioned = p;
-                let pool = &self.pool.0;
-                new.par_iter()
-                    .map(|group| {
-                        // Scratch from the pool (a thread working on two groups at once, as
-                        // rayon may nest, takes a second).
-                        let mut sub = pool
-                            .lock()
-                            .ok()
-                            .and_then(|mut v| v.pop())
-                            .unwrap_or_default();
-                        let r = Self::refine(
-                            &mut sub,
-                            &mut Access::Shared(shared),
-                            tol,
-                            t,
-                            h,
-                            y,
-                            coarse,
-                            f0,
-                            group,
-                            floor,
-                        );
-                        if let Ok(mut v) = pool.lock() {
-                            v.push(sub);
-                        }
-                        r
-                    })
-                    .collect()
-            } else {
-                new.iter().map(|_| Err(Refusal::Relist)).collect()
-            };
+        let mut results: Vec<Result<Refined, Refusal>> = if new.len() >= PARALLEL_GROUPS
+            && p.shares_rates()
+        {
+            let shared: &dyn Partitioned = p;
+            let pool = &self.pool.0;
+            new.par_iter()
+                .map(|group| {
+                    // Scratch from the pool (a thread working on two groups at once, as
+                    // rayon may nest, takes a second).
+                    let mut sub = pool
+                        .lock()
+                        .ok()
+                        .and_then(|mut v| v.pop())
+                        .unwrap_or_default();
+                    let r =
+                        Self::refine(&mut sub, &mut Access::Shared(shared), tol, step, f0, group);
+                    if let Ok(mut v) = pool.lock() {
+                        v.push(sub);
+                    }
+                    r
+                })
+                .collect()
+        } else {
+            new.iter().map(|_| Err(Refusal::Relist)).collect()
+        };
         for (group, result) in new.iter().zip(results.iter_mut()) {
             if matches!(result, Err(Refusal::Relist)) {
-                *result = Self::refine(
-                    &mut self.sub,
-                    &mut Access::Own(p),
-                    tol,
-                    t,
-                    h,
-                    y,
-                    coarse,
-                    f0,
-                    group,
-                    floor,
-                );
+                *result = Self::refine(&mut self.sub, &mut Access::Own(p), tol, step, f0, group);
             }
         }
         let mut crossing = Vec::new();

@@ -3,7 +3,7 @@
 //! again reading that path (see the module docs of [`super`]).
 
 use super::refine::{closure, groups_of, path_at, Access, Refusal, PARALLEL_GROUPS};
-use super::scratch::{Path, Refinement, RingPart, Rounds};
+use super::scratch::{Coarse, Path, Refinement, RingPart, Rounds};
 use super::stepper::Suspension;
 use crate::engine::integrators::system::{GroupJacobian, Partitioned};
 use rayon::prelude::*;
@@ -20,19 +20,22 @@ impl Suspension {
     /// every swimmer in a stiff group of `jac` with one of them, none refined. Read errors found
     /// in an earlier round (`kept`) stand for swimmers none of whose partners were refined anew
     /// (`kept.changed`).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn ring_of(
         &mut self,
         p: &dyn Partitioned,
-        h: f64,
-        y: &[f64],
-        coarse: &[f64],
+        step: &Coarse,
         refined: &[usize],
         e: &[f64],
-        floor: &[f64],
         jac: &GroupJacobian,
         kept: &mut Rounds,
     ) -> Vec<usize> {
+        let Coarse {
+            h,
+            y,
+            end: coarse,
+            floor,
+            ..
+        } = *step;
         let bs = p.body_size();
         let mut near = Vec::new();
         p.partners(refined, &mut near);
@@ -90,18 +93,15 @@ impl Suspension {
     /// partners was refined anew. The ring swimmers that
     /// then miss the tolerance (all of a part's when a contact forms with a swimmer outside it);
     /// when none does, their new states go into `y_new`.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn redo_ring(
         &mut self,
         p: &mut dyn Partitioned,
-        t: f64,
-        h: f64,
-        y: &[f64],
+        step: &Coarse,
         refined: &[usize],
         ring: &[usize],
-        floor: &[f64],
         kept: &mut Rounds,
     ) -> Vec<usize> {
+        let Coarse { t, h, y, floor, .. } = *step;
         if ring.is_empty() {
             return Vec::new();
         }

@@ -1,6 +1,17 @@
 //! What the suspension stepper keeps while it refines a step: the scratch of a refinement (one
 //! per thread), the refined paths, and what the rounds of one coarse step keep for the next.
 
+/// The coarse step a round of refinement works on: from `t` by `h`, its start state `y`, the
+/// states it reached (`end`, before any refinement), and the motion floors of the error measure.
+#[derive(Clone, Copy)]
+pub(super) struct Coarse<'a> {
+    pub(super) t: f64,
+    pub(super) h: f64,
+    pub(super) y: &'a [f64],
+    pub(super) end: &'a [f64],
+    pub(super) floor: &'a [f64],
+}
+
 /// A refined group's path across a coarse step: (time from its start, the group's states).
 pub(super) type Path = Vec<(f64, Vec<f64>)>;
 
