@@ -10,7 +10,7 @@
 //! swimmers about to touch their steps). The far field stays explicit.
 
 use super::system::AveragedSystem;
-use crate::engine::integrators::GroupJacobian;
+use crate::engine::integrators::{ErrorMeasure, GroupJacobian};
 use crate::engine::model::{vec3, STATE_PER_SWIMMER};
 use crate::engine::periodic::separation;
 use nalgebra::Vector3;
@@ -232,17 +232,15 @@ impl AveragedSystem {
     /// kind (centre, orientation) |error| / (tol · max(h·|rate at the start|, floor)), the floor
     /// being DISPLACEMENT_FLOOR × the RMS of that motion over all swimmers (per unit of step in
     /// `floor`, computed when `None`); a swimmer's error is the RMS of its two.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn swimmer_errors(
         &self,
         err: &[f64],
-        h: f64,
-        f0: &[f64],
-        tol: f64,
+        m: &ErrorMeasure,
         bodies: Option<&[usize]>,
         floor: &mut Option<Vec<f64>>,
         out: &mut [f64],
     ) {
+        let (h, f0) = (m.h, m.f0);
         let n = self.coef.len();
         let norm3 =
             |v: &[f64], i: usize| (v[i] * v[i] + v[i + 1] * v[i + 1] + v[i + 2] * v[i + 2]).sqrt();
@@ -264,7 +262,7 @@ impl AveragedSystem {
         let one = |s: usize| {
             let i = STATE_PER_SWIMMER * s;
             let e = [0, 3].map(|o| Vector3::new(err[i + o], err[i + o + 1], err[i + o + 2]));
-            self.error_of(s, e, h, f0, tol, fl)
+            self.error_of(s, e, m, fl)
         };
         match bodies {
             Some(b) => b.iter().for_each(|&s| out[s] = one(s)),
@@ -281,11 +279,10 @@ impl AveragedSystem {
         &self,
         s: usize,
         e: [Vector3<f64>; 2],
-        h: f64,
-        f0: &[f64],
-        tol: f64,
+        m: &ErrorMeasure,
         floor: &[f64],
     ) -> f64 {
+        let (h, f0, tol) = (m.h, m.f0, m.tol);
         let mut sum = 0.0;
         for (kind, fl) in floor.iter().enumerate() {
             let i = STATE_PER_SWIMMER * s + 3 * kind;

@@ -3,7 +3,7 @@
 
 use super::system::{AveragedSystem, LIST_SWIMMERS, PARALLEL_SWIMMERS};
 use crate::engine::integrators::{
-    time_scale_of, GroupJacobian, Noise, OdeSystem, Partitioned, Problem,
+    time_scale_of, ErrorMeasure, GroupJacobian, Noise, OdeSystem, Partitioned, Problem,
 };
 use crate::engine::model::{set_vec3, vec3, STATE_PER_SWIMMER};
 use nalgebra::Vector3;
@@ -70,7 +70,8 @@ impl OdeSystem for AveragedSystem {
         tol: f64,
     ) -> f64 {
         let mut e = vec![0.0; self.coef.len()];
-        self.swimmer_errors(err, h, f0, tol, None, &mut None, &mut e);
+        let m = ErrorMeasure { h, f0, tol };
+        self.swimmer_errors(err, &m, None, &mut None, &mut e);
         (e.iter().map(|e| e * e).sum::<f64>() / e.len().max(1) as f64).sqrt()
     }
 

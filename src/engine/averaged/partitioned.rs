@@ -5,7 +5,7 @@
 //! swimmers that moved are refreshed.
 
 use super::system::AveragedSystem;
-use crate::engine::integrators::{GroupJacobian, Partitioned};
+use crate::engine::integrators::{ErrorMeasure, GroupJacobian, Partitioned};
 use crate::engine::model::{vec3, STATE_PER_SWIMMER};
 use crate::engine::neighbours::NeighbourList;
 use crate::engine::periodic::separation;
@@ -18,17 +18,13 @@ impl Partitioned for AveragedSystem {
 
     fn body_errors(
         &self,
-        _y: &[f64],
-        _y_new: &[f64],
         err: &[f64],
-        h: f64,
-        f0: &[f64],
-        tol: f64,
+        m: &ErrorMeasure,
         bodies: Option<&[usize]>,
         floor: &mut Option<Vec<f64>>,
         out: &mut [f64],
     ) {
-        self.swimmer_errors(err, h, f0, tol, bodies, floor, out);
+        self.swimmer_errors(err, m, bodies, floor, out);
     }
 
     fn partners(&self, bodies: &[usize], out: &mut Vec<usize>) {
@@ -153,16 +149,14 @@ impl Partitioned for AveragedSystem {
 
     fn read_errors(
         &self,
-        before: &[f64],
-        after: &[f64],
+        [before, after]: [&[f64]; 2],
         bodies: &[usize],
         sources: &[usize],
-        h: f64,
-        f0: &[f64],
-        tol: f64,
+        m: &ErrorMeasure,
         floor: &[f64],
         out: &mut [f64],
     ) {
+        let h = m.h;
         let periodic = self.periodic.as_ref();
         let mut partners = Vec::new();
         for &s in bodies {
@@ -188,7 +182,7 @@ impl Partitioned for AveragedSystem {
                 dt += tb - ta;
             }
             let dn = -(dt - ns * ns.dot(&dt));
-            out[s] = self.error_of(s, [dv * h, dn * h], h, f0, tol, floor);
+            out[s] = self.error_of(s, [dv * h, dn * h], m, floor);
         }
     }
 }

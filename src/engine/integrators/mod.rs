@@ -40,6 +40,7 @@ pub use spec::{check_tolerance, Direct, Horizon, IntegratorSpec, Method, METHODS
 pub use stroboscopic::{Stroboscopic, MIN_MACRO};
 pub use suspension::Suspension;
 pub use system::{
-    require_resolvable, time_scale_of, uniform_steps, GroupJacobian, Interrupt, Noise, OdeSystem,
-    Partitioned, Problem, Reach, StateWatch, Stats, StepFailure, Stepper, MIN_RELATIVE_INTERVAL,
+    require_resolvable, time_scale_of, uniform_steps, ErrorMeasure, GroupJacobian, Interrupt,
+    Noise, OdeSystem, Partitioned, Problem, Reach, StateWatch, Stats, StepFailure, Stepper,
+    MIN_RELATIVE_INTERVAL,
 };

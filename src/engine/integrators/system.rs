@@ -111,20 +111,15 @@ pub trait OdeSystem {
 pub trait Partitioned: Sync {
     /// State components per body (the state is the bodies' blocks one after another).
     fn body_size(&self) -> usize;
-    /// Each body's error of a step from `y` to `y_new` (embedded estimate `err`, step `h`, rates
-    /// `f0` at `y`), relative to `tol` (≤ 1: within tolerance), for `bodies` (all when `None`),
+    /// Each body's error of a step (its embedded estimate `err`, measured by `m`: relative to
+    /// `m.tol` of the body's own motion, ≤ 1 within tolerance), for `bodies` (all when `None`),
     /// into `out` (one per body, indexed by body). `floor`: the motion scales below which a
     /// body's own motion is not taken, per unit of step; computed over all bodies when `None` on
     /// entry and left there.
-    #[allow(clippy::too_many_arguments)]
     fn body_errors(
         &self,
-        y: &[f64],
-        y_new: &[f64],
         err: &[f64],
-        h: f64,
-        f0: &[f64],
-        tol: f64,
+        m: &ErrorMeasure,
         bodies: Option<&[usize]>,
         floor: &mut Option<Vec<f64>>,
         out: &mut [f64],
@@ -164,22 +159,30 @@ pub trait Partitioned: Sync {
         false
     }
     /// How much reading the bodies `sources` (sorted) at their states in `after` instead of
-    /// `before` changes the rates of `bodies`, each taken at its state in `before`: h times that
-    /// change as an error of a step of `h` ([`Partitioned::body_errors`]'s measure, with its
-    /// `floor` and the rates `f0` at the step's start), into `out` (indexed by body).
-    #[allow(clippy::too_many_arguments)]
+    /// `before` (`[before, after]`) changes the rates of `bodies`, each taken at its state in
+    /// `before`: h times that change as an error of a step of `m.h` ([`Partitioned::body_errors`]'s
+    /// measure, with its `floor`), into `out` (indexed by body).
     fn read_errors(
         &self,
-        before: &[f64],
-        after: &[f64],
+        views: [&[f64]; 2],
         bodies: &[usize],
         sources: &[usize],
-        h: f64,
-        f0: &[f64],
-        tol: f64,
+        m: &ErrorMeasure,
         floor: &[f64],
         out: &mut [f64],
     );
+}
+
+/// How a step's error is measured against the motion: the step's length `h` (s), the rates `f0`
+/// at its start, and the tolerance `tol`.
+#[derive(Debug, Clone, Copy)]
+pub struct ErrorMeasure<'a> {
+    /// The step (s).
+    pub h: f64,
+    /// The rates at the step's start.
+    pub f0: &'a [f64],
+    /// The tolerance, relative to each body's own motion.
+    pub tol: f64,
 }
 
 /// A block-sparse matrix: a dense square block on each of several disjoint groups of state

@@ -5,7 +5,7 @@
 use super::refine::{closure, groups_of, Refusal};
 use super::scratch::{Coarse, Rounds};
 use super::stepper::Suspension;
-use crate::engine::integrators::system::{GroupJacobian, OdeSystem, Stats};
+use crate::engine::integrators::system::{ErrorMeasure, GroupJacobian, OdeSystem, Stats};
 
 /// The largest share of swimmers a step refines: more, and the whole step is taken again shorter.
 pub const MAX_REFINED_FRACTION: f64 = 0.05;
@@ -38,17 +38,12 @@ impl Suspension {
         let n = y.len() / bs.max(1);
         let mut e = vec![0.0; n];
         let mut floor = None;
-        p.body_errors(
-            y,
-            &self.y_new,
-            &self.err,
+        let m = ErrorMeasure {
             h,
-            &self.f0,
-            self.tol,
-            None,
-            &mut floor,
-            &mut e,
-        );
+            f0: &self.f0,
+            tol: self.tol,
+        };
+        p.body_errors(&self.err, &m, None, &mut floor, &mut e);
         let fast: Vec<usize> = (0..n).filter(|&b| e[b].is_nan() || e[b] > 1.0).collect();
         if fast.is_empty() {
             return whole;

@@ -5,7 +5,7 @@
 use super::refine::{closure, groups_of, path_at, Access, Refusal, PARALLEL_GROUPS};
 use super::scratch::{Coarse, Path, Refinement, RingPart, Rounds};
 use super::stepper::Suspension;
-use crate::engine::integrators::system::{GroupJacobian, Partitioned};
+use crate::engine::integrators::system::{ErrorMeasure, GroupJacobian, Partitioned};
 use rayon::prelude::*;
 
 /// The share of the tolerance by which reading the refined swimmers' path instead of their coarse
@@ -53,17 +53,12 @@ impl Suspension {
             kept.worst.insert(b, 0.0);
         }
         for (before, after) in &self.views {
-            p.read_errors(
-                before,
-                after,
-                &anew,
-                refined,
+            let m = ErrorMeasure {
                 h,
-                &self.f0,
-                self.tol,
-                floor,
-                &mut kept.read,
-            );
+                f0: &self.f0,
+                tol: self.tol,
+            };
+            p.read_errors([before, after], &anew, refined, &m, floor, &mut kept.read);
             for &b in &anew {
                 if let Some(w) = kept.worst.get_mut(&b) {
                     *w = w.max(kept.read[b]);

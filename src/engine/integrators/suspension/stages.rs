@@ -5,7 +5,7 @@ use super::refine::{Access, Refusal};
 use super::scratch::Refinement;
 use super::stepper::Suspension;
 use crate::engine::integrators::rosenbrock::{solution, stage_sums, A, G, GAMMA};
-use crate::engine::integrators::system::{GroupJacobian, OdeSystem, Stats};
+use crate::engine::integrators::system::{ErrorMeasure, GroupJacobian, OdeSystem, Stats};
 
 impl Suspension {
     /// The coarse step h from (t, y), implicit in the stiff groups `jac`: fills y_new and err.
@@ -107,17 +107,13 @@ impl Suspension {
             (sub.y1[m], sub.err[m]) = solution(&sub.k, sub.y0[m], m);
         }
         let mut fl = Some(floor.to_vec());
-        p.get().body_errors(
-            &sub.y0,
-            &sub.y1,
-            &sub.err,
+        let m = ErrorMeasure {
             h,
-            &sub.f0,
+            f0: &sub.f0,
             tol,
-            Some(bodies),
-            &mut fl,
-            &mut sub.errors,
-        );
+        };
+        p.get()
+            .body_errors(&sub.err, &m, Some(bodies), &mut fl, &mut sub.errors);
         let sum: f64 = bodies.iter().map(|&b| sub.errors[b] * sub.errors[b]).sum();
         Ok((sum / bodies.len().max(1) as f64).sqrt())
     }
