@@ -524,12 +524,12 @@ fn adaptive_on_gpu(
             &s.swimmers,
             &s.base,
             &mut s.state,
-            &scale,
             AdaptiveSteps {
                 t0: s.time,
                 t_end,
                 h,
                 rtol,
+                scale: &scale,
             },
             &interrupted,
             peek.as_mut().map(|p| p as Peek<'_>),

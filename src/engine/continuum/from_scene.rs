@@ -2,7 +2,7 @@
 //! into populations, and their smoothed distribution deposited on the grid.
 
 use super::kernel::Constants;
-use super::operator::{Kinetic, Operator};
+use super::operator::{KernelRange, Kinetic, Operator};
 use super::spec::{deposit, populations, ContinuumSpec, Lengths, Particles};
 use super::state::Continuum;
 use crate::engine::averaged::pair_constants;
@@ -89,8 +89,7 @@ impl Continuum {
             sides,
             spec.degree,
             &constants,
-            core,
-            cutoff,
+            KernelRange { core, cutoff },
             &phases,
             diffusion,
         );

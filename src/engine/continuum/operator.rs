@@ -61,18 +61,24 @@ pub(super) struct Kinetic {
     pub(super) pops: usize,
 }
 
+/// The pair kernel's range: its core and its cutoff (m).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct KernelRange {
+    pub(super) core: f64,
+    pub(super) cutoff: f64,
+}
+
 impl Operator {
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn new(
         grid: [usize; 3],
         sides: [f64; 3],
         degree: usize,
         constants: &Constants,
-        core: f64,
-        cutoff: f64,
+        range: KernelRange,
         phases: &[f64],
         diffusion: Option<RigidDiffusion>,
     ) -> Operator {
+        let KernelRange { core, cutoff } = range;
         let sphere = Sphere::new(degree);
         let comps = kernel::components(constants);
         let cells: usize = grid.iter().product();

@@ -370,13 +370,11 @@ impl GpuRun {
     /// them. `y` comes back at the end, after a guard fired (the last accepted state) or an
     /// interrupt. Fewer than 2^30 steps are taken per call; the caller goes on from the time
     /// reported. `peek` (a live view) is shown the run between submissions.
-    #[allow(clippy::too_many_arguments)]
     pub fn run_adaptive(
         &mut self,
         swimmers: &[Dumbbell],
         base: &[Vector3<f64>],
         y: &mut [f64],
-        scale: &[f64],
         steps: AdaptiveSteps,
         interrupted: &dyn Fn() -> bool,
         mut peek: Option<Peek<'_>>,
@@ -386,7 +384,7 @@ impl GpuRun {
         }
         self.upload(swimmers, base, y);
         let q = &self.dev.queue;
-        q.write_buffer(&self.adapt, 0, bytemuck::cast_slice(scale));
+        q.write_buffer(&self.adapt, 0, bytemuck::cast_slice(steps.scale));
         let params = self.params(steps.t0, 0.0, steps.rtol);
         q.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let control = Control::start(steps.t0, steps.t_end, steps.h);

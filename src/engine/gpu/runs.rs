@@ -49,10 +49,10 @@ pub struct UniformSteps {
     pub count: u64,
 }
 
-/// Adaptive steps from `t0` to `t_end`, trying `h` first, at relative tolerance `rtol` (the
-/// method is the buffers' embedded tableau).
+/// Adaptive steps from `t0` to `t_end`, trying `h` first, at relative tolerance `rtol` of each
+/// state component's `scale` (the method is the buffers' embedded tableau).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AdaptiveSteps {
+pub struct AdaptiveSteps<'a> {
     /// Start time (s).
     pub t0: f64,
     /// End time (s).
@@ -61,6 +61,8 @@ pub struct AdaptiveSteps {
     pub h: f64,
     /// Relative tolerance of the error norm.
     pub rtol: f64,
+    /// The absolute size of each state component the tolerance refers to.
+    pub scale: &'a [f64],
 }
 
 /// Where an adaptive run on the device stopped.

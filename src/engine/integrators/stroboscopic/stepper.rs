@@ -159,17 +159,16 @@ impl Stroboscopic {
     /// three times as many as the attempts since the last success sampled (so failed attempts
     /// add at most a third to the direct cost) and twice the last fallback's (from
     /// [`MIN_MACRO`], up to [`MAX_DIRECT_PERIODS`]), then try macro steps again.
-    #[allow(clippy::too_many_arguments)]
     fn fall_back(
         &mut self,
         sys: &mut dyn OdeSystem,
         t: f64,
         y: &mut [f64],
-        whole: u64,
+        t_end: f64,
         why: String,
         stats: &mut Stats,
-        snap: impl Fn(f64) -> f64,
     ) -> Result<f64, StepFailure> {
+        let whole = self.whole_periods(t, t_end);
         self.h_periods = 2.0 * self.paying_periods() as f64;
         let wasted = stats.micro_periods.saturating_sub(self.attempts_from);
         let k = self.direct_periods.max(3 * wasted).min(whole);
@@ -194,7 +193,12 @@ impl Stroboscopic {
             }
         }
         self.slope = None;
-        Ok(self.leave(snap(t + k as f64 * self.period), y))
+        Ok(self.leave(snap_to(t + k as f64 * self.period, t_end, self.period), y))
+    }
+
+    /// The whole periods from `t` to `t_end`.
+    fn whole_periods(&self, t: f64, t_end: f64) -> u64 {
+        ((t_end - t) / self.period + 1e-9).floor().max(0.0) as u64
     }
 
     fn leave(&mut self, t: f64, y: &[f64]) -> f64 {
@@ -232,16 +236,10 @@ impl Stepper for Stroboscopic {
             // costs one step's samples.
             self.h_periods = f64::INFINITY;
         }
-        let whole = ((t_end - t) / period + 1e-9).floor().max(0.0) as u64;
+        let whole = self.whole_periods(t, t_end);
         let min_macro = self.fixed.unwrap_or(MIN_MACRO);
         // A time within rounding of t_end is t_end.
-        let snap = |t_new: f64| {
-            if (t_end - t_new).abs() <= 1e-9 * period {
-                t_end
-            } else {
-                t_new
-            }
-        };
+        let snap = |t_new: f64| snap_to(t_new, t_end, period);
         // Direct: the transient a period at a time; a run or remainder too short for a macro step
         // (and the last fraction of a period) in one go to its end, as the inner method alone
         // would step it.
@@ -296,11 +294,11 @@ impl Stepper for Stroboscopic {
             if self.fixed.is_none() && !heun_next {
                 if m < paying {
                     let why = too_short(self);
-                    return self.fall_back(sys, t, y, whole, why, stats, snap);
+                    return self.fall_back(sys, t, y, t_end, why, stats);
                 }
                 if m == whole && m < 2 * paying {
                     let why = closing();
-                    return self.fall_back(sys, t, y, whole, why, stats, snap);
+                    return self.fall_back(sys, t, y, t_end, why, stats);
                 }
             }
             // A step that ends the run first tries Heun's method: a slow motion over a short run
@@ -327,7 +325,7 @@ impl Stepper for Stroboscopic {
                             } else {
                                 closing()
                             };
-                            return self.fall_back(sys, t, y, whole, why, stats, snap);
+                            return self.fall_back(sys, t, y, t_end, why, stats);
                         }
                     }
                 }
@@ -373,7 +371,7 @@ impl Stepper for Stroboscopic {
                         } else {
                             format!("{rejects} macro steps in a row were rejected; the last: {why}")
                         };
-                        return self.fall_back(sys, t, y, whole, why, stats, snap);
+                        return self.fall_back(sys, t, y, t_end, why, stats);
                     }
                     self.h_periods = m as f64 * shrink;
                 }
@@ -404,5 +402,14 @@ impl Stepper for Stroboscopic {
     fn reset(&mut self) {
         // Kept: the step size and the slope of the state left; `step` restarts (transient and
         // all) only if it is handed another state.
+    }
+}
+
+/// `t_new`, or `t_end` where it lies within rounding of it (a billionth of a `period`).
+fn snap_to(t_new: f64, t_end: f64, period: f64) -> f64 {
+    if (t_end - t_new).abs() <= 1e-9 * period {
+        t_end
+    } else {
+        t_new
     }
 }

@@ -3,7 +3,7 @@
 //! others from the coarse step; groups that read none of each other apart, on rayon's threads
 //! when the system allows (see the module docs of [`super`]).
 
-use super::scratch::{Coarse, Path, Refined, Refinement, Rounds};
+use super::scratch::{Coarse, Path, Refined, Refinement, Rounds, SubsetStep};
 use super::stepper::Suspension;
 use crate::engine::integrators::controller::{step_too_small, StepRule};
 use crate::engine::integrators::system::{GroupJacobian, Partitioned};
@@ -143,8 +143,15 @@ impl Suspension {
             } else {
                 (hs, false)
             };
-            let norm =
-                Self::subset_step(sub, p, tol, t + tau, h_try, bodies, &changed, floor, &at)?;
+            let step = SubsetStep {
+                t0: t + tau,
+                h: h_try,
+                tol,
+                bodies,
+                changed: &changed,
+                floor,
+            };
+            let norm = Self::subset_step(sub, p, &step, &at)?;
             if norm <= 1.0 && norm.is_finite() {
                 for &m in &comps {
                     sub.y0[m] = sub.y1[m];

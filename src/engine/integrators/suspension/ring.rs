@@ -3,7 +3,7 @@
 //! again reading that path (see the module docs of [`super`]).
 
 use super::refine::{closure, groups_of, path_at, Access, Refusal, PARALLEL_GROUPS};
-use super::scratch::{Coarse, Path, Refinement, RingPart, Rounds};
+use super::scratch::{Coarse, Path, Refinement, RingPart, Rounds, SubsetStep};
 use super::stepper::Suspension;
 use crate::engine::integrators::system::{ErrorMeasure, GroupJacobian, Partitioned};
 use rayon::prelude::*;
@@ -253,7 +253,15 @@ impl RingContext<'_> {
                 }
             }
         };
-        Suspension::subset_step(sub, access, self.tol, t, h, part, &changed, self.floor, &at)?;
+        let step = SubsetStep {
+            t0: t,
+            h,
+            tol: self.tol,
+            bodies: part,
+            changed: &changed,
+            floor: self.floor,
+        };
+        Suspension::subset_step(sub, access, &step, &at)?;
         let states = comps().map(|m| sub.y1[m]).collect();
         let errors = part.iter().map(|&b| sub.errors[b]).collect();
         Ok((states, errors))

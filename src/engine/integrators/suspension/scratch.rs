@@ -12,6 +12,19 @@ pub(super) struct Coarse<'a> {
     pub(super) floor: &'a [f64],
 }
 
+/// A step of a subset of the swimmers: from `t0` by `h` at tolerance `tol`, the swimmers
+/// `bodies` stepped, those of `changed` changed since the system last read them, and the motion
+/// floors of the error measure.
+#[derive(Clone, Copy)]
+pub(super) struct SubsetStep<'a> {
+    pub(super) t0: f64,
+    pub(super) h: f64,
+    pub(super) tol: f64,
+    pub(super) bodies: &'a [usize],
+    pub(super) changed: &'a [usize],
+    pub(super) floor: &'a [f64],
+}
+
 /// A refined group's path across a coarse step: (time from its start, the group's states).
 pub(super) type Path = Vec<(f64, Vec<f64>)>;
 

@@ -2,7 +2,7 @@
 //! reading the others from a given path (refinement, the ring).
 
 use super::refine::{Access, Refusal};
-use super::scratch::Refinement;
+use super::scratch::{Refinement, SubsetStep};
 use super::stepper::Suspension;
 use crate::engine::integrators::rosenbrock::{solution, stage_sums, A, G, GAMMA};
 use crate::engine::integrators::system::{ErrorMeasure, GroupJacobian, OdeSystem, Stats};
@@ -53,22 +53,25 @@ impl Suspension {
     }
 }
 impl Suspension {
-    /// One W-method step of `bodies` from `t0` by `h` from their states in `sub.y0`, the other
-    /// states they read set by `read(yw, time)`, the system reached through `p`: fills `sub.y1`,
-    /// `sub.err`, `sub.f0` for their components and returns the RMS of their errors, or why not
-    /// (a contact forming across the edge of `bodies`; shared access that must relist first).
-    #[allow(clippy::too_many_arguments)]
+    /// One W-method step of `step.bodies` from `step.t0` by `step.h` from their states in
+    /// `sub.y0`, the other states they read set by `read(yw, time)`, the system reached through
+    /// `p`: fills `sub.y1`, `sub.err`, `sub.f0` for their components and returns the RMS of their
+    /// errors, or why not (a contact forming across the edge of `bodies`; shared access that must
+    /// relist first).
     pub(super) fn subset_step(
         sub: &mut Refinement,
         p: &mut Access,
-        tol: f64,
-        t0: f64,
-        h: f64,
-        bodies: &[usize],
-        changed: &[usize],
-        floor: &[f64],
+        step: &SubsetStep,
         read: &dyn Fn(&mut [f64], f64),
     ) -> Result<f64, Refusal> {
+        let SubsetStep {
+            t0,
+            h,
+            tol,
+            bodies,
+            changed,
+            floor,
+        } = *step;
         let bs = p.get().body_size();
         let comps = || bodies.iter().flat_map(move |&b| b * bs..(b + 1) * bs);
         for m in comps() {
