@@ -32,7 +32,7 @@ impl ContinuumHandle {
     }
 
     /// Whether `other` is a handle on the same continuum.
-    pub(super) fn same(&self, other: &ContinuumHandle) -> bool {
+    pub(super) fn is_same_as(&self, other: &ContinuumHandle) -> bool {
         Arc::ptr_eq(&self.continuum, &other.continuum)
     }
 

@@ -118,7 +118,7 @@ impl SceneHandle {
     }
 
     /// Whether `other` is a handle on the same scene.
-    pub(super) fn same(&self, other: &SceneHandle) -> bool {
+    pub(super) fn is_same_as(&self, other: &SceneHandle) -> bool {
         Arc::ptr_eq(&self.sim, &other.sim)
     }
 

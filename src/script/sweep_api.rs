@@ -44,14 +44,14 @@ fn sweep(
             let mut here = Reached::default();
             reached_from(p, &mut here, 0);
             for h in here.scenes {
-                if seen.scenes.iter().any(|s| s.same(&h)) {
+                if seen.scenes.iter().any(|s| s.is_same_as(&h)) {
                     shared.scenes.push(h);
                 } else {
                     seen.scenes.push(h);
                 }
             }
             for h in here.continuums {
-                if seen.continuums.iter().any(|c| c.same(&h)) {
+                if seen.continuums.iter().any(|c| c.is_same_as(&h)) {
                     shared.continuums.push(h);
                 } else {
                     seen.continuums.push(h);
@@ -61,13 +61,13 @@ fn sweep(
     }
     let mut scenes: Vec<SceneHandle> = Vec::new();
     for h in shared.scenes {
-        if !scenes.iter().any(|u| u.same(&h)) {
+        if !scenes.iter().any(|u| u.is_same_as(&h)) {
             scenes.push(h);
         }
     }
     let mut continuums: Vec<ContinuumHandle> = Vec::new();
     for h in shared.continuums {
-        if !continuums.iter().any(|u| u.same(&h)) {
+        if !continuums.iter().any(|u| u.is_same_as(&h)) {
             continuums.push(h);
         }
     }

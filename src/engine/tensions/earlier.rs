@@ -16,12 +16,12 @@ const MAX_EXTRAPOLATION_WEIGHT: f64 = 8.0;
 /// lies far closer to the new tensions than the last alone, and the iteration, which stops at a
 /// residual relative to the right side, needs fewer products to get there.
 #[derive(Debug, Clone, Default)]
-pub(super) struct Earlier {
+pub(super) struct PastTensions {
     times: Vec<f64>,
     tensions: Vec<DVector<f64>>,
 }
 
-impl Earlier {
+impl PastTensions {
     /// Keep `x`, solved at `t`, dropping the oldest beyond [`EXTRAPOLATED_FROM`] (a solve at
     /// the newest one's time replaces it).
     pub(super) fn push(&mut self, t: f64, x: &DVector<f64>) {
@@ -86,7 +86,7 @@ mod tests {
     #[test]
     fn the_start_is_extrapolated_from_the_earlier_solves() {
         let f = |t: f64| DVector::from_vec(vec![1.0 + 2.0 * t - 3.0 * t * t, -0.5 * t * t]);
-        let mut e = Earlier::default();
+        let mut e = PastTensions::default();
         let mut x = DVector::zeros(2);
         assert!(!e.extrapolate(0.3, &mut x));
         for t in [0.0, 0.1, 0.2] {

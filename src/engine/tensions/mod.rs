@@ -21,7 +21,7 @@
 //! products (up to [`DENSE_MATRIX_UP_TO`] swimmers) by open space's K at the minimum images,
 //! filled as above and solved on the matrix (an inner iteration, hence the flexible β), and
 //! beyond by the diagonal. Every iteration starts from the tensions of the last solves,
-//! extrapolated in time to this one's ([`Earlier`]); where it stalls, the blocks and elimination
+//! extrapolated in time to this one's ([`PastTensions`]); where it stalls, the blocks and elimination
 //! take over. No route has an S³ term but the elimination of a few swimmers and that fallback.
 //!
 //! - `earlier.rs`: the earlier solves' tensions, extrapolated in time to an iteration's start;
@@ -37,7 +37,7 @@ use super::cg::{cg, CgVectors};
 use super::mobility::self_mobility;
 use super::spheres::Spheres;
 use super::swimmer::Dumbbell;
-use earlier::Earlier;
+use earlier::PastTensions;
 use fill::{fill_blocks, fill_pairs};
 use lower::lower_mul_to;
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -121,7 +121,7 @@ pub struct Tensions {
     /// The iteration's tensions: its start (extrapolated from `earlier`), then its solution.
     x: DVector<f64>,
     /// The last solves' tensions and times.
-    earlier: Earlier,
+    earlier: PastTensions,
     forces: Vec<f64>,
     velocities: Vec<f64>,
     diag: DVector<f64>,
@@ -133,7 +133,7 @@ pub struct Tensions {
     terms: PairTerms,
     /// Whether the products' iteration is preconditioned by open space's K (held in `k`),
     /// solved on the matrix, instead of the diagonal.
-    near: bool,
+    open_space_preconditioner: bool,
     /// The preconditioner's inner iteration: its solution and vectors.
     inner_x: DVector<f64>,
     inner: CgVectors,
@@ -156,8 +156,8 @@ impl Tensions {
     /// A solver for `swimmers` dumbbells that takes `route`.
     pub fn by(route: Route, swimmers: usize) -> Self {
         // The products' iteration holds open space's K as its preconditioner where a matrix fits.
-        let near = route == Route::Products && swimmers <= DENSE_MATRIX_UP_TO;
-        let held = route != Route::Products || near;
+        let open_space_preconditioner = route == Route::Products && swimmers <= DENSE_MATRIX_UP_TO;
+        let held = route != Route::Products || open_space_preconditioner;
         let zeros = || DVector::zeros(swimmers);
         Tensions {
             route,
@@ -167,13 +167,13 @@ impl Tensions {
                 DMatrix::zeros(0, 0)
             },
             x: zeros(),
-            earlier: Earlier::default(),
+            earlier: PastTensions::default(),
             forces: vec![0.0; 6 * swimmers],
             velocities: vec![0.0; 6 * swimmers],
             diag: zeros(),
             outer: CgVectors::zeros(swimmers),
             terms: PairTerms::Open,
-            near,
+            open_space_preconditioner,
             inner_x: zeros(),
             inner: CgVectors::zeros(swimmers),
             products: 0,
@@ -225,7 +225,7 @@ impl Tensions {
                 self.iterate(spheres, swimmers, n, t, rate)
             }
             Route::Products => {
-                if self.near {
+                if self.open_space_preconditioner {
                     fill_pairs(spheres, n, &self.terms, &mut self.k);
                 }
                 self.iterate(spheres, swimmers, n, t, rate)
@@ -267,7 +267,7 @@ impl Tensions {
             velocities,
             diag,
             outer,
-            near,
+            open_space_preconditioner,
             inner_x,
             inner,
             products,
@@ -313,9 +313,9 @@ impl Tensions {
         };
         // z = P⁻¹ r: open space's K solved on the matrix (Jacobi CG to INNER_RTOL) where it is
         // held, else (or where that stalls) the diagonal.
-        let near = *near;
+        let open_space_preconditioner = *open_space_preconditioner;
         let precondition = |r: &DVector<f64>, z: &mut DVector<f64>| {
-            if near {
+            if open_space_preconditioner {
                 inner_x.fill(0.0);
                 inner.r.copy_from(r);
                 let goal = INNER_RTOL * r.norm();
