@@ -336,7 +336,7 @@ fn damaged_checkpoints_are_refused_or_read_never_panic() {
         "18446744073709551616",
         "-0.0",
     ];
-    let mut rng = crate::common::Rng(20261207);
+    let mut rng = crate::common::Rng::new(20261207);
     let (mut refused, mut resumed) = (0, 0);
     for case in 0..400 {
         let bytes = good.as_bytes();

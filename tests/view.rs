@@ -1107,7 +1107,7 @@ fn a_fuzz_of_requests_gets_answers_and_leaves_the_server_serving() {
         "Content-Length: -1",
         "X: \u{00e9}\u{4e2d}",
     ];
-    let mut rng = crate::common::Rng(67_2026);
+    let mut rng = crate::common::Rng::new(67_2026);
     let requests: Vec<Vec<u8>> = (0..400)
         .map(|k| {
             let pick = |rng: &mut crate::common::Rng, n: usize| (rng.next() % n as u64) as usize;

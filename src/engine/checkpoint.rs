@@ -68,10 +68,6 @@ pub struct Resume {
     pub recorders: Vec<(RecorderMark, Vec<Vec<f64>>)>,
 }
 
-fn scene_value(s: &Scene) -> Result<Value> {
-    serde_json::from_str(&s.to_json()?).map_err(|e| invalid!("cannot serialise the scene: {e}"))
-}
-
 impl Checkpoints {
     /// A schedule of checkpoints to `path` on a periodic `trigger` (every n periods or t seconds)
     /// from the scene's time now.
@@ -104,7 +100,7 @@ impl Checkpoints {
             interval,
             trigger: trigger.clone(),
             next_k: 1,
-            setup: scene_value(scene)?,
+            setup: scene.to_json_value()?,
         })
     }
 
@@ -127,7 +123,7 @@ impl Checkpoints {
             return Ok(false);
         }
         let index = self.next_k;
-        let now = scene_value(scene)?;
+        let now = scene.to_json_value()?;
         if let Some(what) = settings_difference(&self.setup, &now) {
             return Err(invalid!(
                 "checkpoint {}: the scene's settings changed since checkpoint() was called (in {what}); a run that goes on from a checkpoint starts from the setup as it was then, so it would not make the change: set the scene up before asking for checkpoints, or take checkpoints in a scene of its own for each stage",
@@ -227,9 +223,7 @@ impl Checkpoints {
                 "checkpoint: {shown} holds a scene whose settings differ from its setup's (in {what}), which no run makes: the file was edited or damaged; {fix}"
             ));
         }
-        let scene_text =
-            serde_json::to_string(&file.scene).map_err(|e| invalid!("checkpoint: {shown}: {e}"))?;
-        let scene = Scene::from_json(&scene_text)
+        let scene = Scene::from_json_value(file.scene)
             .map_err(|e| invalid!("checkpoint: {shown}: {e}; {fix}"))?;
         if file.index == 0 || scene.time() != self.start + file.index as f64 * self.interval {
             return Err(invalid!(

@@ -180,23 +180,13 @@ impl Simulation {
     /// averaging when it falls back to direct integration. A [`Watcher`] is shown the scene when
     /// the run begins, after every step, when recorders take rows, and when the run ends.
     pub fn run(&mut self, duration: f64) -> Result<()> {
-        let Some(w) = self.watcher.clone() else {
-            return self.run_unwatched(duration);
-        };
-        w.settled(&self.scene, &self.recorders);
-        let outcome = self.run_unwatched(duration);
-        w.settled(&self.scene, &self.recorders);
-        outcome
-    }
-
-    fn run_unwatched(&mut self, duration: f64) -> Result<()> {
         require_finite("duration", duration)?;
         if duration < 0.0 {
             return Err(invalid!(
                 "duration must be >= 0 s, got {duration}; the dynamics cannot run backwards"
             ));
         }
-        self.run_unwatched_to(self.scene.time() + duration)
+        self.run_watched_to(self.scene.time() + duration)
     }
 
     /// Advance the scene until its time is `t_end` (s), as [`Simulation::run`] does; a time the
@@ -207,6 +197,11 @@ impl Simulation {
         if t_end <= self.scene.time() {
             return Ok(());
         }
+        self.run_watched_to(t_end)
+    }
+
+    /// The run to `t_end`, the watcher (if any) shown the scene as it begins and as it ends.
+    fn run_watched_to(&mut self, t_end: f64) -> Result<()> {
         let Some(w) = self.watcher.clone() else {
             return self.run_unwatched_to(t_end);
         };

@@ -30,6 +30,7 @@ const GROUPS: &[&str] = &[
 pub static DOCS: LazyLock<Vec<Doc>> = LazyLock::new(|| {
     let mut all: Vec<Doc> = [
         super::scene_api::DOCS,
+        super::run_api::DOCS,
         super::dumbbell_api::DOCS,
         super::scene_settings_api::DOCS,
         super::wall_api::DOCS,

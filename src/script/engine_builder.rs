@@ -4,8 +4,8 @@ use super::source::{read_text, strip_bom, MAX_SOURCE_BYTES};
 use super::{
     checkpoint_api, collective_api, continuum_api, csv_api, dumbbell_api, field_api, float_cmp,
     integrator_api, interrupt, limits, observable_api, panic_guard::guard, params, picture_api,
-    plot_api, render_error, scene_api, scene_settings_api, signatures, stdlib, sweep_api, types,
-    util_api, view_api, wall_api, wrong_calls,
+    plot_api, render_error, run_api, scene_api, scene_settings_api, signatures, stdlib, sweep_api,
+    types, util_api, view_api, wall_api, wrong_calls,
 };
 use rhai::{Dynamic, Engine, EvalAltResult, Scope};
 
@@ -35,6 +35,7 @@ pub(super) fn vocabulary_engine() -> (Engine, rhai::module_resolvers::StaticModu
     dumbbell_api::register(&mut engine);
     integrator_api::register(&mut engine);
     scene_api::register(&mut engine);
+    run_api::register(&mut engine);
     scene_settings_api::register(&mut engine);
     wall_api::register(&mut engine);
     observable_api::register(&mut engine);

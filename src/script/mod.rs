@@ -24,6 +24,7 @@ mod picture_api;
 mod plot_api;
 pub mod progress;
 mod render;
+mod run_api;
 mod scene_api;
 mod scene_settings_api;
 mod show;

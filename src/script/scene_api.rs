@@ -357,16 +357,6 @@ fn add_at(s: &mut SceneHandle, d: DumbbellSpec, centres: &Array) -> ScriptResult
     s.replace(trial)
 }
 
-/// Run `f` with a progress bar over the next `duration` seconds (only at a terminal).
-fn with_bar<T>(
-    sc: &mut Simulation,
-    duration: f64,
-    f: impl FnOnce(&mut Simulation) -> crate::engine::Result<T>,
-) -> crate::engine::Result<T> {
-    let (t0, period) = (sc.time(), sc.period().ok());
-    super::progress::with_bar(sc, t0, duration, period, Simulation::set_progress, f)
-}
-
 /// Register the `Scene` type and its methods and properties.
 pub fn register(engine: &mut Engine) {
     engine.register_fn("scene", SceneHandle::default);
@@ -561,90 +551,26 @@ pub fn register(engine: &mut Engine) {
                 .map_err(|e| script_error(format!("load_scene(\"{path}\"): {e}")))
         });
 
-    // Running.
-    engine
-        .register_fn(
-            "run",
-            |s: &mut SceneHandle, duration: Dynamic| -> ScriptResult<()> {
-                let d = number("run(duration)", &duration)?;
-                s.with_sim(|sim| with_bar(sim, d, |sim| sim.run(d)))
-            },
-        )
-        .register_fn(
-            "run_periods",
-            |s: &mut SceneHandle, n: Dynamic| -> ScriptResult<()> {
-                let n = number("run_periods(n)", &n)?;
-                s.with_sim(|sim| {
-                    let d = sim.period().map_or(0.0, |t| n * t);
-                    with_bar(sim, d, |sim| sim.run_periods(n))
-                })
-            },
-        )
-        .register_fn(
-            "run_to",
-            |s: &mut SceneHandle, t: Dynamic| -> ScriptResult<()> {
-                let t = number("run_to(t)", &t)?;
-                s.with_sim(|sim| {
-                    let d = (t - sim.time()).max(0.0);
-                    with_bar(sim, d, |sim| sim.run_to(t))
-                })
-            },
-        )
-        .register_fn(
-            "run_to_periods",
-            |s: &mut SceneHandle, n: Dynamic| -> ScriptResult<()> {
-                let n = number("run_to_periods(n)", &n)?;
-                s.with_sim(|sim| {
-                    let t = n * sim.period()?;
-                    let d = (t - sim.time()).max(0.0);
-                    with_bar(sim, d, |sim| sim.run_to(t))
-                })
-            },
-        )
-        .register_get("stats", |s: &mut SceneHandle| {
-            let st = s.borrow().stats();
+    engine.register_fn(
+        "diffusion",
+        |s: &mut SceneHandle, i: INT| -> ScriptResult<rhai::Map> {
+            let i = usize::try_from(i).map_err(|_| {
+                super::convert::script_error(format!("swimmer index {i} is negative"))
+            })?;
+            let d = s.with(|sc| sc.rigid_diffusion(i))?;
             let mut m = rhai::Map::new();
-            m.insert("steps".into(), (st.steps as INT).into());
-            m.insert("rejected".into(), (st.rejected as INT).into());
-            m.insert("rhs_evals".into(), (st.rhs_evals as INT).into());
-            m.insert(
-                "rejected_by_guard".into(),
-                (st.rejected_by_guard as INT).into(),
-            );
-            m.insert("macro_steps".into(), (st.macro_steps as INT).into());
-            m.insert("micro_periods".into(), (st.micro_periods as INT).into());
-            m.insert("noisy_steps".into(), (st.noisy_steps as INT).into());
-            m.insert("refined_steps".into(), (st.refined_steps as INT).into());
-            m.insert(
-                "direct_fallbacks".into(),
-                (st.direct_fallbacks as INT).into(),
-            );
-            m.insert(
-                "fallback_periods".into(),
-                (st.fallback_periods as INT).into(),
-            );
-            m
-        })
-        .register_fn(
-            "diffusion",
-            |s: &mut SceneHandle, i: INT| -> ScriptResult<rhai::Map> {
-                let i = usize::try_from(i).map_err(|_| {
-                    super::convert::script_error(format!("swimmer index {i} is negative"))
-                })?;
-                let d = s.with(|sc| sc.rigid_diffusion(i))?;
-                let mut m = rhai::Map::new();
-                for (k, v) in [
-                    ("parallel", d.parallel),
-                    ("perpendicular", d.perpendicular),
-                    ("translation", d.translation()),
-                    ("rotation", d.rotation),
-                    ("offset", d.offset),
-                ] {
-                    m.insert(k.into(), v.into());
-                }
-                Ok(m)
-            },
-        );
+            for (k, v) in [
+                ("parallel", d.parallel),
+                ("perpendicular", d.perpendicular),
+                ("translation", d.translation()),
+                ("rotation", d.rotation),
+                ("offset", d.offset),
+            ] {
+                m.insert(k.into(), v.into());
+            }
+            Ok(m)
+        },
+    );
 }
 
 /// The help text of this file's script names (`:help NAME`), gathered by [`super::docs`].
@@ -657,12 +583,7 @@ pub(super) const DOCS: &[Doc] = &[
     doc_entry!("set_phase", "phases", "s.set_phase(i, phi)", "Set the stroke phase of swimmer i (rad).", "let s = scene(); s.add(dumbbell()); s.set_phase(0, pi()); print(s.phases);"),
     doc_entry!("add_random", "scene", "s.add_random(d, n, volume_fraction, seed) -> int\ns.add_random(d, n, volume_fraction, seed, #{ aligned: [x, y, z], phase: p }) -> int\ns.add_random(d, n, seed[, opts]) -> int  (in a periodic box)", "Add n copies of dumbbell d at random places in a cube centred on the origin, sized so that all spheres fill the given volume fraction (in a periodic box: the box itself, measured by minimum images), without overlaps (random sequential addition, seeded: the same seed gives the same scene). Above a wall only places clear of it are taken (put the wall below the cube to fill all of it; a wall above the cube, where no centre can be clear of it, is refused). A count that cannot fit is refused before the first draw, naming how many do: each swimmer keeps clear a body of its two spheres widened by half the gap, and random sequential addition fills about 27% (equal spheres far apart) to 35% (overlapping ones) of the space with such bodies within its 100 draws for every body the space holds, where it stops with \"placed only k of n\". Orientations and phases are random unless fixed by the options; gap: m sets the smallest sphere gap at placement (default 4 lambda max(w1, w2), what the strokes can close). Returns the new swimmer count; on failure the scene is unchanged.", "let s = scene(); s.add_random(dumbbell(#{}), 20, 0.01, 1); print(s.count);"),
     doc_entry!("add_at", "scene", "s.add_at(d, centres: array) -> int", "Add a copy of dumbbell d (its orientation and phase) at every centre [x, y, z] (m) of the array, e.g. a lattice from the stdlib module \"lattice\". All or nothing: if one does not fit, the scene is unchanged. Returns the new swimmer count.", "import \"lattice\" as lattice; let s = scene(); s.add_at(dumbbell(), lattice::cubic(2, 2, 2, 20e-6)); print(s.count);"),
-    doc_entry!("run", "running", "s.run(seconds)", "Advance the scene; Ctrl-C stops at a clean step boundary and keeps the state.", "let s = scene(); s.add(dumbbell()); s.run(1e-3); print(s.time);"),
-    doc_entry!("run_periods", "running", "s.run_periods(n)", "Advance n stroke periods 2 pi/omega (the swimmers' omega must agree).", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.time);"),
-    doc_entry!("run_to", "running", "s.run_to(t)", "Advance until the scene's time is t (s); a time the scene has reached already runs nothing and takes no row. With s.checkpoint, a script that runs to absolute times goes on where a checkpoint left it.", "let s = scene(); s.add(dumbbell()); s.run_to(1e-3); s.run_to(1e-3); print(s.time);"),
-    doc_entry!("run_to_periods", "running", "s.run_to_periods(n)", "Advance until the scene's time is n stroke periods 2 pi/omega (the swimmers' omega must agree); nothing where it is there already (see run_to).", "let s = scene(); s.add(dumbbell()); s.run_to_periods(2); print(s.time);"),
     doc_entry!("diffusion", "thermal", "s.diffusion(i) -> map", "Swimmer i's diffusion as a rigid dumbbell of length ell at the scene's temperature and mobility: parallel and perpendicular translation D_par, D_perp (m^2/s), their orientation average translation = (D_par + 2 D_perp)/3 (a centre's mean squared displacement grows as 6 translation t), rotation D_r (1/s), and offset: where along N from R_H translation and rotation decouple (m). All zero at 0 K. The averaged model's noise; for a symmetric dumbbell translation equals kT/(12 pi mu)(1/a + 1/ell).", "let s = scene(); s.add(dumbbell()); s.temperature = 300; print(s.diffusion(0).translation);"),
-    doc_entry!("stats", "running", "s.stats -> map", "Work counters: steps, rejected steps, right-hand-side evaluations; macro_steps and micro_periods of stroboscopic averaging, and direct_fallbacks and fallback_periods, the times its macro steps failed at their shortest length and the periods it then integrated directly (s.integrator_info says why); noisy_steps, the steps taken with thermal noise (also the noise generator's counter); refined_steps, the short steps suspension(tol) took for a few swimmers inside its steps.", "let s = scene(); s.add(dumbbell()); s.run_periods(1); print(s.stats);"),
     doc_entry!("sphere_velocities", "reading", "s.sphere_velocities(forces) -> [[vx, vy, vz], ...]", "Sphere velocities (m/s) for given forces (N): one [fx, fy, fz] per sphere, swimmer by swimmer, the a1 sphere first; the scene's mobility and viscosity at the present sphere positions, Stokes drag included. For checks against other codes; the scene does not move.", "let s = scene(); s.add(dumbbell()); print(s.sphere_velocities([[1e-12, 0, 0], [0, 0, 0]]));"),
     doc_entry!("center", "reading", "s.center(i) -> [x, y, z]", "Hydrodynamic centre R_H of swimmer i (m).", "let s = scene(); s.add(dumbbell()); print(s.center(0));"),
     doc_entry!("dir", "reading", "s.dir(i) -> [x, y, z]", "Unit orientation N of swimmer i (from the a1 sphere to the a2 sphere).", "let s = scene(); s.add(dumbbell(#{ dir: [0, 1, 0] })); print(s.dir(0));"),

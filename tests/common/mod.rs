@@ -118,15 +118,15 @@ pub fn about_to_touch() -> Scene {
 
 pub mod cli;
 
-/// SplitMix64, the fuzz tests' generator: the same scripts on every machine.
-pub struct Rng(pub u64);
+/// The fuzz tests' generator: the engine's SplitMix64 ([`swimlab::engine::rng::Rng`]), so the
+/// same scripts on every machine, and a pick from a list.
+pub struct Rng(swimlab::engine::rng::Rng);
 impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(swimlab::engine::rng::Rng::new(seed))
+    }
     pub fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
     pub fn pick<'a>(&mut self, from: &[&'a str]) -> &'a str {
         from[(self.next() % from.len() as u64) as usize]

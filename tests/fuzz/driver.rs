@@ -92,7 +92,7 @@ impl Fuzz {
             from_env("SWIMLAB_FUZZ_SEED", self.seed),
             from_env("SWIMLAB_FUZZ_SCRIPTS", self.scripts),
         );
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let mut interrupted = 0;
         for k in 0..scripts {
             let src = make(&mut rng);

@@ -12,6 +12,13 @@ pub const MAX_TIME_IN_PERIODS: f64 = 1e9;
 /// Version of the JSON layout written by [`Scene::to_json`].
 pub const SAVE_FORMAT: u32 = 1;
 
+/// A scene file as read.
+#[derive(Deserialize)]
+struct Loaded {
+    format: u32,
+    scene: SceneFile,
+}
+
 #[derive(Serialize)]
 struct SavedScene {
     format: u32,
@@ -142,15 +149,31 @@ impl Scene {
         .map_err(|e| invalid!("cannot serialise the scene: {e}"))
     }
 
+    /// The scene as [`Scene::to_json`] writes it, as a JSON value (a checkpoint nests it).
+    pub fn to_json_value(&self) -> Result<serde_json::Value> {
+        serde_json::to_value(SavedScene {
+            format: SAVE_FORMAT,
+            scene: SceneFile::of(self),
+        })
+        .map_err(|e| invalid!("cannot serialise the scene: {e}"))
+    }
+
     /// A scene from [`Scene::to_json`] output.
     pub fn from_json(text: &str) -> Result<Scene> {
-        #[derive(Deserialize)]
-        struct Loaded {
-            format: u32,
-            scene: SceneFile,
-        }
-        let loaded: Loaded =
-            serde_json::from_str(text).map_err(|e| invalid!("not a swimlab scene file: {e}"))?;
+        Self::from_loaded(
+            serde_json::from_str(text).map_err(|e| invalid!("not a swimlab scene file: {e}"))?,
+        )
+    }
+
+    /// A scene from [`Scene::to_json_value`] output.
+    pub fn from_json_value(value: serde_json::Value) -> Result<Scene> {
+        Self::from_loaded(
+            serde_json::from_value(value).map_err(|e| invalid!("not a swimlab scene file: {e}"))?,
+        )
+    }
+
+    /// The scene of a file read, every value checked as the setters check it.
+    fn from_loaded(loaded: Loaded) -> Result<Scene> {
         if loaded.format != SAVE_FORMAT {
             return Err(invalid!(
                 "scene file format {} is not supported (this swimlab reads format {SAVE_FORMAT})",

@@ -195,31 +195,20 @@ impl Suspension {
             changed.sort_unstable();
             changed.dedup();
         }
-        let mut results: Vec<Result<Refined, Refusal>> = if new.len() >= PARALLEL_GROUPS
-            && p.shares_rates()
-        {
-            let shared: &dyn Partitioned = p;
-            let pool = &self.pool.0;
-            new.par_iter()
-                .map(|group| {
-                    // Scratch from the pool (a thread working on two groups at once, as
-                    // rayon may nest, takes a second).
-                    let mut sub = pool
-                        .lock()
-                        .ok()
-                        .and_then(|mut v| v.pop())
-                        .unwrap_or_default();
-                    let r =
-                        Self::refine(&mut sub, &mut Access::Shared(shared), tol, step, f0, group);
-                    if let Ok(mut v) = pool.lock() {
-                        v.push(sub);
-                    }
-                    r
-                })
-                .collect()
-        } else {
-            new.iter().map(|_| Err(Refusal::Relist)).collect()
-        };
+        let mut results: Vec<Result<Refined, Refusal>> =
+            if new.len() >= PARALLEL_GROUPS && p.shares_rates() {
+                let shared: &dyn Partitioned = p;
+                let pool = &self.pool;
+                new.par_iter()
+                    .map(|group| {
+                        pool.with(|sub| {
+                            Self::refine(sub, &mut Access::Shared(shared), tol, step, f0, group)
+                        })
+                    })
+                    .collect()
+            } else {
+                new.iter().map(|_| Err(Refusal::Relist)).collect()
+            };
         for (group, result) in new.iter().zip(results.iter_mut()) {
             if matches!(result, Err(Refusal::Relist)) {
                 *result = Self::refine(&mut self.sub, &mut Access::Own(p), tol, step, f0, group);

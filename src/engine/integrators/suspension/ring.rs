@@ -124,27 +124,17 @@ impl Suspension {
             refined,
             floor,
         };
-        let mut results: Vec<Result<RingPart, Refusal>> =
-            if todo.len() >= PARALLEL_GROUPS && p.shares_rates() {
-                let shared: &dyn Partitioned = p;
-                let pool = &self.pool.0;
-                todo.par_iter()
-                    .map(|part| {
-                        let mut sub = pool
-                            .lock()
-                            .ok()
-                            .and_then(|mut v| v.pop())
-                            .unwrap_or_default();
-                        let r = ctx.step_part(&mut sub, &mut Access::Shared(shared), part);
-                        if let Ok(mut v) = pool.lock() {
-                            v.push(sub);
-                        }
-                        r
-                    })
-                    .collect()
-            } else {
-                todo.iter().map(|_| Err(Refusal::Relist)).collect()
-            };
+        let mut results: Vec<Result<RingPart, Refusal>> = if todo.len() >= PARALLEL_GROUPS
+            && p.shares_rates()
+        {
+            let shared: &dyn Partitioned = p;
+            let pool = &self.pool;
+            todo.par_iter()
+                .map(|part| pool.with(|sub| ctx.step_part(sub, &mut Access::Shared(shared), part)))
+                .collect()
+        } else {
+            todo.iter().map(|_| Err(Refusal::Relist)).collect()
+        };
         for (part, result) in todo.iter().zip(results.iter_mut()) {
             if matches!(result, Err(Refusal::Relist)) {
                 *result = ctx.step_part(&mut self.sub, &mut Access::Own(&mut *p), part);

@@ -96,6 +96,24 @@ impl Refinement {
 #[derive(Debug, Default)]
 pub(super) struct Pool(pub(super) std::sync::Mutex<Vec<Refinement>>);
 
+impl Pool {
+    /// Run `f` with scratch from the pool, given back after (a thread working on two groups at
+    /// once, as rayon may nest, takes a second).
+    pub(super) fn with<T>(&self, f: impl FnOnce(&mut Refinement) -> T) -> T {
+        let mut sub = self
+            .0
+            .lock()
+            .ok()
+            .and_then(|mut v| v.pop())
+            .unwrap_or_default();
+        let r = f(&mut sub);
+        if let Ok(mut v) = self.0.lock() {
+            v.push(sub);
+        }
+        r
+    }
+}
+
 impl Clone for Pool {
     fn clone(&self) -> Self {
         Pool::default()
