@@ -68,6 +68,7 @@ mod script_numbers;
 mod shipped_scripts;
 mod streams_and_signals;
 mod stroboscopic;
+mod study;
 mod suspensions;
 mod sweeps;
 mod thermal;

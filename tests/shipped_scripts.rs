@@ -47,7 +47,8 @@ fn run_without_a_file_runs_the_built_in_experiment() {
 /// every code path of the script. The density study's `--quick` runs every state of the study
 /// with the spring model (about three minutes on two cores); here one state, with the quick
 /// mode's two seeds (its standard errors need two). The bulk demo's quick mode runs 300 swimmers
-/// in each of its four cases; here 100.
+/// in each of its four cases; here 100. The instantaneous comparison's quick mode takes four
+/// densities; here the thinnest and the densest, with the open-space check.
 fn smaller(path: &std::path::Path) -> Vec<&'static str> {
     if path.ends_with("study/densities.rhai") {
         vec![
@@ -58,6 +59,8 @@ fn smaller(path: &std::path::Path) -> Vec<&'static str> {
             "--set",
             "phases=two",
         ]
+    } else if path.ends_with("study/instantaneous.rhai") {
+        vec!["--set", "densities=0.001,0.03", "--set", "open=true"]
     } else if path.ends_with("demos/bulk.rhai") {
         vec!["--set", "n=100"]
     } else {

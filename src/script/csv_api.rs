@@ -1,4 +1,4 @@
-//! `write_csv(path, rows)` / `write_csv(path, columns, rows)`: tables from scripts.
+//! `write_csv(path, rows)` / `write_csv(path, columns, rows[, #{ notes }])`: tables from scripts.
 
 use super::convert::{describe, script_error, ScriptResult};
 use super::doc::{doc_entry, Doc};
@@ -15,9 +15,15 @@ fn cell(v: &Dynamic) -> String {
     }
 }
 
-/// Write `rows` (maps) under the header `columns` to `path`, creating parent folders (through a
-/// temporary file renamed over `path`: a crash keeps the old file whole).
-pub fn write_table(path: &str, columns: &[String], rows: &[Map]) -> ScriptResult<()> {
+/// Write `rows` (maps) under the header `columns` to `path`, after `notes` as comment lines
+/// ("# " and the note), creating parent folders (through a temporary file renamed over `path`: a
+/// crash keeps the old file whole).
+pub fn write_table(
+    path: &str,
+    columns: &[String],
+    rows: &[Map],
+    notes: &[String],
+) -> ScriptResult<()> {
     let mut records = Vec::with_capacity(rows.len());
     for (k, row) in rows.iter().enumerate() {
         let record: Vec<String> = columns
@@ -34,6 +40,11 @@ pub fn write_table(path: &str, columns: &[String], rows: &[Map]) -> ScriptResult
     }
     super::convert::lift(check_csv_name(Path::new(path), "write_csv"))?;
     super::convert::lift(write_atomically(Path::new(path), |w| {
+        for note in notes {
+            for line in note.lines() {
+                writeln!(w, "# {line}")?;
+            }
+        }
         let mut csv = csv::Writer::from_writer(w);
         csv.write_record(columns)?;
         for r in &records {
@@ -57,6 +68,32 @@ fn maps(rows: Array) -> ScriptResult<Vec<Map>> {
         .collect()
 }
 
+/// The notes of `write_csv`'s options: #{ notes: [text, ...] } (or one text).
+fn notes(options: Map) -> ScriptResult<Vec<String>> {
+    let mut out = Vec::new();
+    for (key, value) in options {
+        if key != "notes" {
+            return Err(script_error(format!(
+                "write_csv: unknown option \"{key}\"; the options are #{{ notes: [\"made by ...\"] }}"
+            )));
+        }
+        let items = match value.clone().try_cast::<Array>() {
+            Some(a) => a,
+            None => vec![value],
+        };
+        for item in items {
+            let got = describe(&item);
+            let text = item.into_immutable_string().map_err(|_| {
+                script_error(format!(
+                    "write_csv: each note is a text, such as run_info().command; got {got}"
+                ))
+            })?;
+            out.push(text.to_string());
+        }
+    }
+    Ok(out)
+}
+
 /// Register `write_csv`.
 pub fn register(engine: &mut Engine) {
     engine
@@ -64,7 +101,14 @@ pub fn register(engine: &mut Engine) {
             "write_csv",
             |path: &str, columns: Array, rows: Array| -> ScriptResult<()> {
                 let cols: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
-                write_table(path, &cols, &maps(rows)?)
+                write_table(path, &cols, &maps(rows)?, &[])
+            },
+        )
+        .register_fn(
+            "write_csv",
+            |path: &str, columns: Array, rows: Array, options: Map| -> ScriptResult<()> {
+                let cols: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
+                write_table(path, &cols, &maps(rows)?, &notes(options)?)
             },
         )
         .register_fn("write_csv", |path: &str, rows: Array| -> ScriptResult<()> {
@@ -73,7 +117,7 @@ pub fn register(engine: &mut Engine) {
                 .first()
                 .map(|r| r.keys().map(|k| k.to_string()).collect())
                 .unwrap_or_default();
-            write_table(path, &cols, &rows)
+            write_table(path, &cols, &rows, &[])
         });
 }
 
@@ -81,7 +125,7 @@ pub fn register(engine: &mut Engine) {
 pub(super) const DOCS: &[Doc] = &[doc_entry!(
     "write_csv",
     "files",
-    "write_csv(path, rows)\nwrite_csv(path, columns, rows)",
-    "Write an array of maps as CSV (columns in the given order, or sorted). A name ending in another format's extension (.png, .svg, .gif, .vti, .vtp, .pvd, .xyz, .json, ...) is refused: CSV text under it would open in no program for that format.",
+    "write_csv(path, rows)\nwrite_csv(path, columns, rows)\nwrite_csv(path, columns, rows, #{ notes })",
+    "Write an array of maps as CSV (columns in the given order, or sorted). notes: texts written first as comment lines (\"# \" and the text; pandas reads them with comment=\"#\"), such as what made the file: let i = run_info(); #{ notes: [i.command, i.build, i.machine] }. A name ending in another format's extension (.png, .svg, .gif, .vti, .vtp, .pvd, .xyz, .json, ...) is refused: CSV text under it would open in no program for that format.",
     "write_csv(\"out/help/t.csv\", [\"D\", \"v\"], [#{ D: 10.0, v: 1e-6 }]);"
 )];

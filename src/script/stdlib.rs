@@ -11,6 +11,7 @@ pub const MODULES: &[(&str, &str)] = &[
     ("measure", include_str!("../../stdlib/measure.rhai")),
     ("lattice", include_str!("../../stdlib/lattice.rhai")),
     ("figures", include_str!("../../stdlib/figures.rhai")),
+    ("study", include_str!("../../stdlib/study.rhai")),
 ];
 
 /// Compile the embedded modules with `engine`, install the resolver (embedded modules first, then

@@ -1,4 +1,5 @@
-//! Small helpers scripts need: number formatting, `pi()`, and the quick mode of long scripts.
+//! Small helpers scripts need: number formatting, `pi()`, the quick mode of long scripts, and
+//! what made a result (`run_info()`).
 
 use super::convert::{number, ScriptResult};
 use super::doc::{doc_entry, Doc};
@@ -31,6 +32,73 @@ pub fn uniform_randoms(n: INT, seed: INT) -> ScriptResult<rhai::Array> {
         .collect())
 }
 
+/// The first value of `key` in a `key : value` listing such as /proc/cpuinfo.
+fn listed(text: &str, key: &str) -> Option<String> {
+    text.lines().find_map(|l| {
+        let (k, v) = l.split_once(':')?;
+        (k.trim() == key).then(|| v.trim().to_string())
+    })
+}
+
+/// This machine in words: its CPU model, logical cores, widest vector unit and memory (what
+/// Linux's /proc says; "unknown CPU" elsewhere).
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| listed(&t, "model name"))
+        .unwrap_or_else(|| "unknown CPU".to_string());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let memory = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| listed(&t, "MemTotal"))
+        .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
+        .map_or(String::new(), |kb| {
+            format!(", {:.0} GiB", kb / (1u64 << 20) as f64)
+        });
+    format!(
+        "{cpu}, {cores} logical cores, {}{memory}",
+        crate::engine::simd::vector_unit()
+    )
+}
+
+/// What made a result: #{ command (the command line), build (version, commit, profile),
+/// machine }.
+fn run_info() -> rhai::Map {
+    let command = std::env::args()
+        .enumerate()
+        .map(|(i, a)| {
+            let a = if i == 0 {
+                std::path::Path::new(&a)
+                    .file_name()
+                    .map_or(a.clone(), |f| f.to_string_lossy().into_owned())
+            } else {
+                a
+            };
+            if a.is_empty() || a.contains([' ', '"', '\'']) {
+                format!("{a:?}")
+            } else {
+                a
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ");
+    let profile = if cfg!(debug_assertions) {
+        "debug"
+    } else {
+        "release"
+    };
+    let build = format!(
+        "swimlab {} (commit {}, {profile} build)",
+        env!("CARGO_PKG_VERSION"),
+        env!("SWIMLAB_COMMIT")
+    );
+    let mut m = rhai::Map::new();
+    m.insert("command".into(), command.into());
+    m.insert("build".into(), build.into());
+    m.insert("machine".into(), machine().into());
+    m
+}
+
 /// `x` as text padded to `width` characters, on the left (`right == false`) or the right.
 fn pad(x: &Dynamic, width: INT, right: bool) -> ScriptResult<String> {
     let what = if right {
@@ -53,6 +121,7 @@ pub fn register(engine: &mut Engine) {
     engine
         .register_fn("pi", || std::f64::consts::PI)
         .register_fn("quick", quick)
+        .register_fn("run_info", run_info)
         .register_fn("uniform_randoms", uniform_randoms)
         .register_fn("sci", |x: Dynamic| -> ScriptResult<String> {
             Ok(sci(number("sci(x)", &x)?, 4))
@@ -123,6 +192,13 @@ pub(super) const DOCS: &[Doc] = &[
         "quick() -> bool",
         "True under `swimlab run --quick` (or SWIMLAB_QUICK=1): long scripts run a short variant.",
         "let n = if quick() { 1 } else { 100 }; print(n);"
+    ),
+    doc_entry!(
+        "run_info",
+        "formatting",
+        "run_info() -> map",
+        "What is making this result: #{ command: the command line, build: swimlab's version, the commit it was built from (\"-modified\" where tracked files differed) and the profile, machine: the CPU, logical cores, vector unit and memory }. Results committed beside a text carry it: write_csv(path, columns, rows, #{ notes: [...] }).",
+        "let i = run_info(); print(i.build);"
     ),
     doc_entry!(
         "is_number",
