@@ -170,6 +170,6 @@ fn the_instantaneous_study_tables_follow_from_its_swimmer_rows() {
     // so its own error lies well under 1e-2 while the models differ by tens of percent.
     let own = num(&table[0]["own_error_v_rms"]);
     assert!(own < 1e-2 && own < 0.1 * rms, "own {own}, models {rms}");
-    assert!(num(&table[0]["open_v_rms"]) > 0.0);
+    assert!(num(&table[0]["open_v_rms"]) > 0.0 && num(&table[0]["first_v_rms"]) > 0.0);
     assert!(dir.join("inst_density.svg").exists() && dir.join("inst_nearest.svg").exists());
 }
