@@ -77,9 +77,10 @@ fn notes(options: Map) -> ScriptResult<Vec<String>> {
                 "write_csv: unknown option \"{key}\"; the options are #{{ notes: [\"made by ...\"] }}"
             )));
         }
-        let items = match value.clone().try_cast::<Array>() {
-            Some(a) => a,
-            None => vec![value],
+        let items = if value.is_array() {
+            value.cast::<Array>()
+        } else {
+            vec![value]
         };
         for item in items {
             let got = describe(&item);

@@ -34,6 +34,7 @@ pub mod stdlib;
 mod sweep_api;
 mod types;
 mod util_api;
+pub use util_api::shell_quote;
 pub mod view_api;
 mod wall_api;
 mod wrong_calls;

@@ -61,27 +61,21 @@ pub(super) fn register(engine: &mut Engine) {
         )
         .register_get("stats", |s: &mut SceneHandle| {
             let st = s.borrow().stats();
-            let mut m = rhai::Map::new();
-            m.insert("steps".into(), (st.steps as INT).into());
-            m.insert("rejected".into(), (st.rejected as INT).into());
-            m.insert("rhs_evals".into(), (st.rhs_evals as INT).into());
-            m.insert(
-                "rejected_by_guard".into(),
-                (st.rejected_by_guard as INT).into(),
-            );
-            m.insert("macro_steps".into(), (st.macro_steps as INT).into());
-            m.insert("micro_periods".into(), (st.micro_periods as INT).into());
-            m.insert("noisy_steps".into(), (st.noisy_steps as INT).into());
-            m.insert("refined_steps".into(), (st.refined_steps as INT).into());
-            m.insert(
-                "direct_fallbacks".into(),
-                (st.direct_fallbacks as INT).into(),
-            );
-            m.insert(
-                "fallback_periods".into(),
-                (st.fallback_periods as INT).into(),
-            );
-            m
+            [
+                ("steps", st.steps),
+                ("rejected", st.rejected),
+                ("rhs_evals", st.rhs_evals),
+                ("rejected_by_guard", st.rejected_by_guard),
+                ("macro_steps", st.macro_steps),
+                ("micro_periods", st.micro_periods),
+                ("noisy_steps", st.noisy_steps),
+                ("refined_steps", st.refined_steps),
+                ("direct_fallbacks", st.direct_fallbacks),
+                ("fallback_periods", st.fallback_periods),
+            ]
+            .into_iter()
+            .map(|(k, v)| (k.into(), (v as INT).into()))
+            .collect::<rhai::Map>()
         });
 }
 

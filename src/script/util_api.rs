@@ -61,6 +61,18 @@ fn machine() -> String {
     )
 }
 
+/// `s` quoted for a POSIX shell (as it stands where it needs no quotes).
+pub fn shell_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/._-=,+:".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
 /// What made a result: #{ command (the command line), build (version, commit, profile),
 /// machine }.
 fn run_info() -> rhai::Map {
@@ -74,11 +86,7 @@ fn run_info() -> rhai::Map {
             } else {
                 a
             };
-            if a.is_empty() || a.contains([' ', '"', '\'']) {
-                format!("{a:?}")
-            } else {
-                a
-            }
+            shell_quote(&a)
         })
         .collect::<Vec<_>>()
         .join(" ");
